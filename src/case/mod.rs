@@ -1,0 +1,1 @@
+//! Case files: the TOML schema, loading with located errors, and validation.

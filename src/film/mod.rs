@@ -1,0 +1,47 @@
+//! The rendered image and its outputs: HDR colour plus the depth and normal AOVs, written as one
+//! linear EXR and as tone-mapped PNGs.
+
+use serde::Deserialize;
+
+/// A rendered frame. Pixels are row-major with row 0 at the top of the picture.
+///
+/// `depth` is the hit distance along the primary ray (`+inf` on a miss) and `normal` the world
+/// normal at that hit (zero on a miss); both come from one ray through the pixel centre, so they
+/// are never blended across an edge.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Film {
+    pub width: u32,
+    pub height: u32,
+    pub color: Vec<[f32; 3]>,
+    pub depth: Vec<f32>,
+    pub normal: Vec<[f32; 3]>,
+}
+
+impl Film {
+    /// A black film with every AOV set to "miss".
+    pub fn new(width: u32, height: u32) -> Self {
+        let n = width as usize * height as usize;
+        Film {
+            width,
+            height,
+            color: vec![[0.0; 3]; n],
+            depth: vec![f32::INFINITY; n],
+            normal: vec![[0.0; 3]; n],
+        }
+    }
+
+    #[inline]
+    pub fn index(&self, x: u32, y: u32) -> usize {
+        y as usize * self.width as usize + x as usize
+    }
+}
+
+/// How linear colour becomes 8-bit PNG values.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Tonemap {
+    /// Clamp to [0, 1], apply the sRGB transfer curve, round to nearest.
+    Srgb,
+    /// The assignment's quantisation: `trunc(c·255)` clamped to [0, 255], no gamma.
+    Clamp,
+}

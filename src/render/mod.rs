@@ -1,0 +1,26 @@
+//! Turning a scene into a film: camera, lights, materials, sampling, the Whitted integrator and
+//! the supersampling filter.
+
+use serde::Deserialize;
+
+/// Which camera and image conventions to follow.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Profile {
+    /// Pixel centres, vertical fov with aspect correction, orthonormal camera basis.
+    #[default]
+    Native,
+    /// The course's reference renderer, quirks included (DESIGN.md, "The assignment profile").
+    Mit6837,
+}
+
+/// How each output pixel is reconstructed from samples.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum Filter {
+    /// Each pixel is the mean of its own samples.
+    #[default]
+    None,
+    /// Render at 3× width and height, then weight each 3×3 block by [1 2 1]⊗[1 2 1]/16.
+    Gaussian,
+}
