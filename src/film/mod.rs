@@ -3,6 +3,16 @@
 
 use serde::Deserialize;
 
+mod exr;
+mod output;
+mod png;
+
+pub use self::exr::{decode_exr, encode_exr, read_exr, write_exr};
+pub use self::output::{
+    OutputError, OutputOptions, encode_png, write_file_atomic, write_outputs, write_png,
+};
+pub use self::png::{color_image, depth_image, normals_image};
+
 /// A rendered frame. Pixels are row-major with row 0 at the top of the picture.
 ///
 /// `depth` is the hit distance along the primary ray (`+inf` on a miss) and `normal` the world

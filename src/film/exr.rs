@@ -1,0 +1,272 @@
+//! The linear EXR: the one output that golden comparisons and external viewers (tev, Blender,
+//! OpenImageIO) trust, so it must hold exactly what was rendered and be byte-stable.
+
+use std::io::Cursor;
+use std::panic::{self, AssertUnwindSafe};
+use std::path::Path;
+
+use ::exr::meta::MetaData;
+use ::exr::prelude::{
+    AnyChannel, AnyChannels, Blocks, Compression, Encoding, FlatSamples, Image, Layer,
+    LayerAttributes, LineOrder, ReadChannels, ReadLayers, WritableImage, read,
+};
+
+use super::Film;
+use super::output::{OutputError, write_file_atomic};
+
+/// What in-memory EXR bytes are called in messages, where there is no file path to name.
+const IN_MEMORY: &str = "EXR data";
+
+/// The most pixel bytes a decoded file may claim. The exr crate allocates every channel before it
+/// reads a single block, so a corrupt header claiming a gigantic image would abort the process on
+/// allocation failure instead of returning an error. 1 GiB is about a 6000×6000 film with all
+/// seven channels: far beyond any golden image, far below a header typo.
+const MAX_DECODE_BYTES: usize = 1 << 30;
+
+/// The channels goldray writes, in the contract's order, which is also the order in which the
+/// first non-finite value of a pixel is reported.
+const CHANNELS: [&str; 7] = ["R", "G", "B", "Z", "N.X", "N.Y", "N.Z"];
+
+/// Encodes the film as a one-part, ZIP-compressed, increasing-line-order f32 scanline EXR.
+///
+/// Compression runs on the calling thread: the exr crate's parallel writer builds a fresh thread
+/// pool per file (the renderer has already used every core by the time a film is written), and
+/// sequential blocks in increasing order make the bytes a pure function of the film.
+pub fn encode_exr(film: &Film) -> Result<Vec<u8>, OutputError> {
+    encode_exr_named(film, IN_MEMORY)
+}
+
+/// Reads the first part of an EXR. Only R, G and B are required so that EXRs from other tools
+/// (or goldray files stripped of AOVs) can still be compared; a missing depth is a miss (`+inf`)
+/// and a missing normal is zero, the same values a miss renders to.
+pub fn decode_exr(bytes: &[u8]) -> Result<Film, OutputError> {
+    decode_exr_named(bytes, IN_MEMORY)
+}
+
+/// [`decode_exr`] on a file, with the path in every error.
+pub fn read_exr(path: &Path) -> Result<Film, OutputError> {
+    let bytes = std::fs::read(path).map_err(|source| OutputError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    decode_exr_named(&bytes, &path.display().to_string())
+}
+
+/// [`encode_exr`] written atomically: a reader sees the old file or the new one, never a part.
+pub fn write_exr(path: &Path, film: &Film) -> Result<(), OutputError> {
+    let bytes = encode_exr_named(film, &path.display().to_string())?;
+    write_file_atomic(path, &bytes)
+}
+
+/// [`encode_exr`] with `file` (the destination) named in its errors.
+pub(super) fn encode_exr_named(film: &Film, file: &str) -> Result<Vec<u8>, OutputError> {
+    check_film(film, file)?;
+    let channel = |name: &str, values: Vec<f32>| AnyChannel::new(name, FlatSamples::F32(values));
+    let channels = AnyChannels::sort(
+        [
+            channel("R", film.color.iter().map(|c| c[0]).collect()),
+            channel("G", film.color.iter().map(|c| c[1]).collect()),
+            channel("B", film.color.iter().map(|c| c[2]).collect()),
+            channel("Z", film.depth.clone()),
+            channel("N.X", film.normal.iter().map(|n| n[0]).collect()),
+            channel("N.Y", film.normal.iter().map(|n| n[1]).collect()),
+            channel("N.Z", film.normal.iter().map(|n| n[2]).collect()),
+        ]
+        .into_iter()
+        .collect(),
+    );
+    let encoding = Encoding {
+        compression: Compression::ZIP16,
+        blocks: Blocks::ScanLines,
+        line_order: LineOrder::Increasing,
+    };
+    let size = (film.width as usize, film.height as usize);
+    let layer = Layer::new(size, LayerAttributes::default(), encoding, channels);
+    let mut bytes = Vec::new();
+    Image::from_layer(layer)
+        .write()
+        .non_parallel()
+        .to_buffered(Cursor::new(&mut bytes))
+        .map_err(|source| OutputError::EncodeExr {
+            file: file.to_owned(),
+            source,
+        })?;
+    Ok(bytes)
+}
+
+/// Refuses a film whose buffers disagree with its size, or that holds a value no viewer or metric
+/// can use. Depth alone may be `+inf`: that is how a miss is stored.
+fn check_film(film: &Film, file: &str) -> Result<(), OutputError> {
+    let pixels = film.width as usize * film.height as usize;
+    if film.width == 0
+        || film.height == 0
+        || [film.color.len(), film.depth.len(), film.normal.len()] != [pixels; 3]
+    {
+        return Err(OutputError::FilmShape {
+            file: file.to_owned(),
+            width: film.width,
+            height: film.height,
+            colors: film.color.len(),
+            depths: film.depth.len(),
+            normals: film.normal.len(),
+        });
+    }
+    let pixel_values = film.color.iter().zip(&film.depth).zip(&film.normal);
+    for (i, ((color, &depth), normal)) in pixel_values.enumerate() {
+        let values = [
+            color[0], color[1], color[2], depth, normal[0], normal[1], normal[2],
+        ];
+        let bad = values.iter().zip(CHANNELS).find(|&(&value, channel)| {
+            if channel == "Z" {
+                value.is_nan()
+            } else {
+                !value.is_finite()
+            }
+        });
+        if let Some((&value, channel)) = bad {
+            return Err(OutputError::NonFinite {
+                file: file.to_owned(),
+                x: (i % film.width as usize) as u32,
+                y: (i / film.width as usize) as u32,
+                channel,
+                value,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// [`decode_exr`] with `file` (the source) named in its errors.
+fn decode_exr_named(bytes: &[u8], file: &str) -> Result<Film, OutputError> {
+    let invalid = |source| OutputError::DecodeExr {
+        file: file.to_owned(),
+        source,
+    };
+    let unsupported = |reason: String| OutputError::UnsupportedExr {
+        file: file.to_owned(),
+        reason,
+    };
+
+    let meta = MetaData::read_from_buffered(bytes, false).map_err(invalid)?;
+    let claimed = meta.headers.iter().try_fold(0usize, |total, header| {
+        let layer = header
+            .layer_size
+            .area()
+            .checked_mul(header.channels.bytes_per_pixel)?;
+        total.checked_add(layer)
+    });
+    if claimed.is_none_or(|bytes| bytes > MAX_DECODE_BYTES) {
+        return Err(unsupported(format!(
+            "its header claims more than {MAX_DECODE_BYTES} bytes of pixels"
+        )));
+    }
+
+    // The exr crate is fuzzed but not panic-free on every corrupt block; an unreadable golden
+    // file must be an error the comparator can report, not a crashed test run.
+    let image = panic::catch_unwind(AssertUnwindSafe(|| {
+        read()
+            .no_deep_data()
+            .largest_resolution_level()
+            .all_channels()
+            .first_valid_layer()
+            .all_attributes()
+            .non_parallel()
+            .from_buffered(Cursor::new(bytes))
+    }))
+    .map_err(|_| unsupported("the EXR decoder failed on its contents".to_owned()))?
+    .map_err(invalid)?;
+
+    let layer = image.layer_data;
+    let (width, height) = (layer.size.width(), layer.size.height());
+    let too_big = || unsupported(format!("its size {width}x{height} does not fit a film"));
+    let mut film = Film::new(
+        u32::try_from(width).map_err(|_| too_big())?,
+        u32::try_from(height).map_err(|_| too_big())?,
+    );
+
+    let channel = |name: &'static str| -> Result<Option<Vec<f32>>, OutputError> {
+        let Some(found) = layer.channel_data.list.iter().find(|c| c.name == *name) else {
+            return Ok(None);
+        };
+        if found.sample_data.len() != width * height {
+            return Err(unsupported(format!("its {name} channel is subsampled")));
+        }
+        Ok(Some(found.sample_data.values_as_f32().collect()))
+    };
+    let required = |name: &'static str| {
+        channel(name)?.ok_or_else(|| OutputError::MissingChannel {
+            file: file.to_owned(),
+            channel: name,
+        })
+    };
+
+    let [r, g, b] = [required("R")?, required("G")?, required("B")?];
+    for (i, pixel) in film.color.iter_mut().enumerate() {
+        *pixel = [r[i], g[i], b[i]];
+    }
+    if let Some(z) = channel("Z")? {
+        film.depth = z;
+    }
+    for (axis, name) in ["N.X", "N.Y", "N.Z"].into_iter().enumerate() {
+        if let Some(values) = channel(name)? {
+            for (normal, value) in film.normal.iter_mut().zip(values) {
+                normal[axis] = value;
+            }
+        }
+    }
+    Ok(film)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn first_bad_value_is_named_by_pixel_and_channel() {
+        let mut film = Film::new(3, 2);
+        film.normal[4][1] = f32::NEG_INFINITY;
+        film.color[5][0] = f32::NAN;
+        let message = encode_exr(&film).unwrap_err().to_string();
+        assert!(message.contains("pixel (1, 1)"), "{message}");
+        assert!(message.contains("N.Y"), "{message}");
+    }
+
+    #[test]
+    fn depth_may_be_infinite_but_not_nan() {
+        let mut film = Film::new(2, 2);
+        assert!(encode_exr(&film).is_ok());
+        film.depth[2] = f32::NAN;
+        let message = encode_exr(&film).unwrap_err().to_string();
+        assert!(
+            message.contains("pixel (0, 1)") && message.contains(" Z "),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn a_header_claiming_a_huge_image_is_refused_before_allocating() {
+        let mut bytes = encode_exr(&Film::new(4, 4)).unwrap();
+        let key = b"dataWindow\0box2i\0";
+        let at = bytes.windows(key.len()).position(|w| w == key).unwrap() + key.len() + 4;
+        bytes[at + 8..at + 16].copy_from_slice(&[[0xff, 0xff, 0, 0]; 2].concat());
+        let error = decode_exr(&bytes).unwrap_err();
+        assert!(
+            matches!(error, OutputError::UnsupportedExr { .. }),
+            "{error}"
+        );
+    }
+
+    #[test]
+    fn mismatched_buffers_and_empty_films_are_refused() {
+        let mut film = Film::new(2, 2);
+        film.depth.pop();
+        assert!(matches!(
+            encode_exr(&film),
+            Err(OutputError::FilmShape { .. })
+        ));
+        assert!(matches!(
+            encode_exr(&Film::new(0, 4)),
+            Err(OutputError::FilmShape { .. })
+        ));
+    }
+}

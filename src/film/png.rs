@@ -1,0 +1,210 @@
+//! 8-bit previews of the film. Colour goes through the case's tone map; depth and normals are data,
+//! so they skip the sRGB curve but keep the tone map's rounding rule, which lets the `clamp`
+//! (assignment) profile reproduce the reference renderer's depth and normal PNGs value for value.
+
+use image::{Rgb, RgbImage};
+
+use super::{Film, Tonemap};
+
+/// Colour as the case asks: `Srgb` for viewing, `Clamp` for the assignment's `trunc(c·255)`.
+pub fn color_image(film: &Film, tonemap: Tonemap) -> RgbImage {
+    quantised_image(film, tonemap, |i| {
+        let color = film.color.get(i).copied().unwrap_or_default();
+        color.map(|c| match tonemap {
+            Tonemap::Srgb => srgb_encode(c.clamp(0.0, 1.0)),
+            Tonemap::Clamp => c,
+        })
+    })
+}
+
+/// Grey `(t − min)/(max − min)`: near is dark, far is white, and a miss is black (as in the
+/// assignment) so that background never reads as "very far geometry".
+pub fn depth_image(film: &Film, min: f32, max: f32, tonemap: Tonemap) -> RgbImage {
+    quantised_image(film, tonemap, |i| {
+        let t = film.depth.get(i).copied().unwrap_or(f32::INFINITY);
+        let grey = if t == f32::INFINITY {
+            0.0
+        } else {
+            (t - min) / (max - min)
+        };
+        [grey; 3]
+    })
+}
+
+/// `(n + 1)/2` per axis; a miss has normal 0 and so shows mid-grey (127 with `Clamp`, 128 with
+/// `Srgb`).
+pub fn normals_image(film: &Film, tonemap: Tonemap) -> RgbImage {
+    quantised_image(film, tonemap, |i| {
+        let normal = film.normal.get(i).copied().unwrap_or_default();
+        normal.map(|n| (n + 1.0) / 2.0)
+    })
+}
+
+/// The one loop behind every preview: `value` gives pixel `i`'s three channels in [0, 1] (anything
+/// outside, NaN included, is tolerated) and each is quantised by the tone map's rule. A film whose
+/// buffers are shorter than its size shows the missing pixels as misses rather than panicking;
+/// the EXR encoder is what rejects such a film.
+fn quantised_image(film: &Film, tonemap: Tonemap, value: impl Fn(usize) -> [f32; 3]) -> RgbImage {
+    RgbImage::from_fn(film.width, film.height, |x, y| {
+        Rgb(value(film.index(x, y)).map(|v| quantise(v, tonemap)))
+    })
+}
+
+/// `Clamp` truncates like the assignment's `(int)(c·255)`, `Srgb` rounds to nearest. NaN is 0 and
+/// ±inf saturate, so no render value can make a preview fail.
+fn quantise(v: f32, tonemap: Tonemap) -> u8 {
+    if v.is_nan() {
+        return 0;
+    }
+    let scaled = v.clamp(0.0, 1.0) * 255.0;
+    match tonemap {
+        Tonemap::Clamp => scaled.trunc() as u8,
+        Tonemap::Srgb => scaled.round() as u8,
+    }
+}
+
+/// The piecewise sRGB transfer curve of IEC 61966-2-1 (not a pure 2.2 gamma, which would darken
+/// the shadows by several codes).
+fn srgb_encode(linear: f32) -> f32 {
+    if linear <= 0.003_130_8 {
+        12.92 * linear
+    } else {
+        1.055 * linear.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn film_with(color: [f32; 3], depth: f32, normal: [f32; 3]) -> Film {
+        let mut film = Film::new(1, 1);
+        film.color[0] = color;
+        film.depth[0] = depth;
+        film.normal[0] = normal;
+        film
+    }
+
+    fn colour(c: f32, tonemap: Tonemap) -> u8 {
+        color_image(&film_with([c; 3], 1.0, [0.0; 3]), tonemap)
+            .get_pixel(0, 0)
+            .0[0]
+    }
+
+    fn depth(t: f32, tonemap: Tonemap) -> u8 {
+        depth_image(&film_with([0.0; 3], t, [0.0; 3]), 8.0, 18.0, tonemap)
+            .get_pixel(0, 0)
+            .0[0]
+    }
+
+    #[test]
+    fn srgb_matches_the_standard_at_known_points() {
+        assert_eq!(colour(0.0, Tonemap::Srgb), 0);
+        assert_eq!(colour(0.5, Tonemap::Srgb), 188);
+        assert_eq!(colour(0.18, Tonemap::Srgb), 118);
+        assert_eq!(colour(0.002, Tonemap::Srgb), 7); // linear segment: 12.92 · 0.002 · 255 = 6.6
+        assert_eq!(colour(1.0, Tonemap::Srgb), 255);
+        assert_eq!(colour(7.0, Tonemap::Srgb), 255);
+        assert_eq!(colour(-1.0, Tonemap::Srgb), 0);
+    }
+
+    #[test]
+    fn srgb_pieces_meet_at_the_boundary() {
+        let boundary = 0.003_130_8_f32;
+        let above = 1.055 * boundary.powf(1.0 / 2.4) - 0.055;
+        assert!((srgb_encode(boundary) - above).abs() < 1e-5);
+        assert_eq!(colour(boundary, Tonemap::Srgb), 10); // 0.04045 · 255 = 10.3
+        assert_eq!(
+            colour(f32::from_bits(boundary.to_bits() + 1), Tonemap::Srgb),
+            10
+        );
+    }
+
+    #[test]
+    fn clamp_truncates_like_the_assignment() {
+        assert_eq!(colour(0.999, Tonemap::Clamp), 254);
+        assert_eq!(colour(1.0, Tonemap::Clamp), 255);
+        assert_eq!(colour(1.5, Tonemap::Clamp), 255);
+        assert_eq!(colour(0.5, Tonemap::Clamp), 127);
+        assert_eq!(colour(-0.1, Tonemap::Clamp), 0);
+    }
+
+    #[test]
+    fn non_finite_values_never_escape_the_byte_range() {
+        for tonemap in [Tonemap::Srgb, Tonemap::Clamp] {
+            assert_eq!(colour(f32::NAN, tonemap), 0);
+            assert_eq!(colour(f32::INFINITY, tonemap), 255);
+            assert_eq!(colour(f32::NEG_INFINITY, tonemap), 0);
+        }
+    }
+
+    #[test]
+    fn depth_is_dark_near_white_far_and_black_on_a_miss() {
+        assert_eq!(depth(f32::INFINITY, Tonemap::Clamp), 0);
+        assert_eq!(depth(f32::INFINITY, Tonemap::Srgb), 0);
+        assert_eq!(depth(8.0, Tonemap::Clamp), 0);
+        assert_eq!(depth(2.0, Tonemap::Clamp), 0);
+        assert_eq!(depth(18.0, Tonemap::Clamp), 255);
+        assert_eq!(depth(1e30, Tonemap::Clamp), 255);
+        assert!(depth(10.0, Tonemap::Clamp) < depth(16.0, Tonemap::Clamp));
+    }
+
+    #[test]
+    fn depth_uses_the_quantiser_without_the_srgb_curve() {
+        // (13 − 8)/10 = 0.5: truncated 127, rounded 128; the sRGB curve would give 188.
+        assert_eq!(depth(13.0, Tonemap::Clamp), 127);
+        assert_eq!(depth(13.0, Tonemap::Srgb), 128);
+    }
+
+    #[test]
+    fn normals_map_minus_one_to_one_onto_the_byte_range() {
+        let film = film_with([0.0; 3], 3.0, [-1.0, 1.0, 0.0]);
+        assert_eq!(
+            normals_image(&film, Tonemap::Clamp).get_pixel(0, 0).0,
+            [0, 255, 127]
+        );
+        assert_eq!(
+            normals_image(&film, Tonemap::Srgb).get_pixel(0, 0).0,
+            [0, 255, 128]
+        );
+    }
+
+    #[test]
+    fn a_missed_pixel_has_grey_127_normals_with_clamp() {
+        let film = Film::new(2, 1);
+        assert_eq!(
+            normals_image(&film, Tonemap::Clamp).get_pixel(1, 0).0,
+            [127; 3]
+        );
+    }
+
+    #[test]
+    fn images_keep_row_zero_at_the_top() {
+        let mut film = Film::new(1, 2);
+        film.color[0] = [1.0; 3];
+        let image = color_image(&film, Tonemap::Clamp);
+        assert_eq!(
+            (image.get_pixel(0, 0).0, image.get_pixel(0, 1).0),
+            ([255; 3], [0; 3])
+        );
+    }
+
+    #[test]
+    fn a_film_with_short_buffers_renders_as_misses() {
+        let mut film = Film::new(2, 2);
+        film.color.clear();
+        film.depth.clear();
+        film.normal.clear();
+        assert_eq!(color_image(&film, Tonemap::Clamp).get_pixel(1, 1).0, [0; 3]);
+        assert_eq!(
+            depth_image(&film, 0.0, 1.0, Tonemap::Clamp)
+                .get_pixel(1, 1)
+                .0,
+            [0; 3]
+        );
+        assert_eq!(
+            normals_image(&film, Tonemap::Clamp).get_pixel(1, 1).0,
+            [127; 3]
+        );
+    }
+}
