@@ -1,1 +1,91 @@
 //! Case files: the TOML schema, loading with located errors, and validation.
+//!
+//! A case is validated completely here, once, so that everything downstream can take its numbers
+//! at face value; and every rejection names the file, line and column, what was found and what
+//! would be valid, because a case file is edited by hand.
+
+mod error;
+mod objects;
+mod sections;
+mod spec;
+mod value;
+
+#[cfg(test)]
+mod tests;
+
+use std::path::Path;
+
+use toml::de::DeTable;
+
+pub use error::{CaseError, SourceLocation};
+pub use sections::{MAX_BOUNCES, MAX_IMAGE_SIZE};
+pub use spec::{
+    BackgroundSpec, CameraSpec, Case, LightSpec, MaterialSpec, ObjectSpec, RenderSettings,
+    ShapeSpec, Tolerance, TransformOp, composite_matrix,
+};
+
+use value::{Doc, Table};
+
+#[derive(Clone, Debug, Default)]
+pub struct LoadOptions {
+    /// Lifts the `MAX_IMAGE_SIZE` guard (the CLI's `--force`).
+    pub allow_huge_images: bool,
+}
+
+const TOP_LEVEL_KEYS: &[&str] = &[
+    "description",
+    "render",
+    "tolerance",
+    "camera",
+    "background",
+    "light",
+    "materials",
+    "object",
+];
+
+pub fn load(path: &Path, options: &LoadOptions) -> Result<Case, CaseError> {
+    let source = std::fs::read_to_string(path).map_err(|source| CaseError::Read {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    parse(&source, path, options)
+}
+
+/// `path` is not read: it names the case in messages and anchors its relative asset paths.
+pub fn parse(source: &str, path: &Path, options: &LoadOptions) -> Result<Case, CaseError> {
+    let root = DeTable::parse(source).map_err(|e| CaseError::Syntax {
+        location: SourceLocation::from_offset(path, source, e.span().map_or(0, |s| s.start)),
+        message: e.message().to_owned(),
+    })?;
+    let doc = Doc {
+        file: path,
+        text: source,
+        dir: path.parent().unwrap_or(Path::new("")),
+        options,
+    };
+    let top = Table::new(
+        &doc,
+        "the case file".to_owned(),
+        root.span(),
+        root.get_ref(),
+    );
+    top.check_keys(TOP_LEVEL_KEYS)?;
+    let materials = sections::materials(top.get("materials"))?;
+    Ok(Case {
+        name: path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+        path: path.to_path_buf(),
+        description: top.read("description", None, |f| {
+            f.string().map(|s| Some(s.to_owned()))
+        })?,
+        render: sections::render(&doc, top.get("render"))?,
+        tolerance: sections::tolerance(&doc, top.get("tolerance"))?,
+        camera: sections::camera(&doc, top.get("camera"))?,
+        background: sections::background(&doc, top.get("background"))?,
+        lights: sections::lights(top.get("light"))?,
+        objects: top.read("object", Vec::new(), |f| objects::objects(f, &materials))?,
+        materials,
+    })
+}
