@@ -1,0 +1,393 @@
+//! Triangle meshes with their own BVH, built once and shared (behind an `Arc`) by every
+//! instance that places the mesh in a scene.
+
+use std::path::PathBuf;
+
+use crate::geometry::aabb::Aabb;
+use crate::geometry::bvh::Bvh;
+use crate::geometry::triangle::{
+    TriangleHit, TriangleRay, face_normal, intersect_triangle, normalize, triangle_surface,
+};
+use crate::geometry::{Ray, SurfaceHit};
+use crate::real::{Real, Vec3};
+
+#[derive(Debug, thiserror::Error)]
+pub enum MeshError {
+    #[error("the mesh has no triangles")]
+    NoTriangles,
+    #[error("{count} triangles or vertices are more than 32-bit indices can address")]
+    TooLarge { count: usize },
+    #[error("vertex {vertex} has a non-finite coordinate: {position}")]
+    NonFinitePosition { vertex: usize, position: Vec3 },
+    #[error("triangle {triangle} uses vertex {index}, but there are only {vertex_count} vertices")]
+    VertexIndexOutOfRange {
+        triangle: usize,
+        index: u32,
+        vertex_count: usize,
+    },
+    #[error("{found} triangles of normal indices were given for {expected} triangles")]
+    NormalTriangleCount { expected: usize, found: usize },
+    #[error("triangle {triangle} uses normal {index}, but there are only {normal_count} normals")]
+    NormalIndexOutOfRange {
+        triangle: usize,
+        index: u32,
+        normal_count: usize,
+    },
+    #[error("cannot read {}: {source}", path.display())]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{}:{line}: {problem}", path.display())]
+    Malformed {
+        path: PathBuf,
+        line: usize,
+        problem: String,
+    },
+    #[error("{}: the file has no faces", path.display())]
+    NoFaces { path: PathBuf },
+    #[error("{}: the OBJ reader failed: {source}", path.display())]
+    Obj {
+        path: PathBuf,
+        source: tobj::LoadError,
+    },
+    #[error("{}: {source}", path.display())]
+    InFile {
+        path: PathBuf,
+        source: Box<MeshError>,
+    },
+}
+
+/// The vertex normals a mesh is built with.
+#[derive(Clone, Debug)]
+pub enum VertexNormals {
+    /// The assignment's rule: a vertex normal is the normalised, unweighted sum of the unit
+    /// normals of the triangles using that vertex (by position index). Zero-area triangles
+    /// have no normal and contribute nothing.
+    Averaged,
+    /// Normals with their own index triples, one per triangle, as OBJ `vn` data comes.
+    Indexed {
+        normals: Vec<Vec3>,
+        triangles: Vec<[u32; 3]>,
+    },
+}
+
+/// Which vertex normals [`Mesh::load_obj`] uses.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum NormalSource {
+    /// The file's `vn` normals when every face corner references one, otherwise averaged.
+    FromFileOrAveraged,
+    /// Always [`VertexNormals::Averaged`], ignoring any `vn` (the assignment's behaviour).
+    Averaged,
+}
+
+/// The closest hit found by [`Mesh::intersect`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MeshHit {
+    pub t: Real,
+    /// Index in the mesh's own (BVH) order, as used by [`Mesh::triangle`].
+    pub triangle: u32,
+    pub barycentrics: [Real; 3],
+}
+
+/// A triangle mesh ready for ray queries.
+///
+/// Triangles are stored in BVH leaf order with their corner positions inline, so a leaf's
+/// triangles are adjacent in memory and testing one needs no index indirection. Normals that
+/// are zero or not finite (from the file, or averaged over degenerate or cancelling faces) are
+/// stored as zero; a triangle with any such corner is shaded with its geometric normal.
+#[derive(Clone, Debug)]
+pub struct Mesh {
+    corners: Vec<[Vec3; 3]>,
+    normal_indices: Vec<[u32; 3]>,
+    normals: Vec<Vec3>,
+    bvh: Bvh,
+}
+
+impl Mesh {
+    /// Validates the data (finite positions, indices in range, at least one triangle) and
+    /// builds the BVH.
+    pub fn new(
+        positions: &[Vec3],
+        triangles: &[[u32; 3]],
+        vertex_normals: VertexNormals,
+    ) -> Result<Mesh, MeshError> {
+        validate(positions, triangles)?;
+        let (normals, normal_indices) = match vertex_normals {
+            VertexNormals::Averaged => (averaged_normals(positions, triangles), triangles.to_vec()),
+            VertexNormals::Indexed {
+                normals,
+                triangles: normal_triangles,
+            } => {
+                validate_normal_indices(&normals, &normal_triangles, triangles.len())?;
+                let unit = normals
+                    .iter()
+                    .map(|&n| normalize(n).unwrap_or(Vec3::ZERO))
+                    .collect();
+                (unit, normal_triangles)
+            }
+        };
+        let corners_of = |[a, b, c]: [u32; 3]| {
+            [
+                positions[a as usize],
+                positions[b as usize],
+                positions[c as usize],
+            ]
+        };
+        let bounds: Vec<Aabb> = triangles
+            .iter()
+            .map(|&t| Aabb::from_points(corners_of(t)))
+            .collect();
+        let (bvh, order) = Bvh::build(&bounds).into_leaf_order();
+        Ok(Mesh {
+            corners: order
+                .iter()
+                .map(|&i| corners_of(triangles[i as usize]))
+                .collect(),
+            normal_indices: order.iter().map(|&i| normal_indices[i as usize]).collect(),
+            normals,
+            bvh,
+        })
+    }
+
+    /// The closest hit in `(0, t_max]`.
+    pub fn intersect(&self, ray: &Ray, t_max: Real) -> Option<MeshHit> {
+        let triangle_ray = TriangleRay::new(ray);
+        let mut closest = None;
+        self.bvh.closest(ray, t_max, |triangle, t_limit| {
+            let [p0, p1, p2] = self.corners[triangle as usize];
+            let hit = intersect_triangle(&triangle_ray, t_limit, p0, p1, p2)?;
+            closest = Some(MeshHit {
+                t: hit.t,
+                triangle,
+                barycentrics: [hit.b0, hit.b1, hit.b2],
+            });
+            Some(hit.t)
+        })?;
+        closest
+    }
+
+    /// Whether anything is hit in `(0, t_max]`; cheaper than [`Mesh::intersect`] because it
+    /// stops at the first hit.
+    pub fn occluded(&self, ray: &Ray, t_max: Real) -> bool {
+        let triangle_ray = TriangleRay::new(ray);
+        self.bvh.any(ray, t_max, |triangle, t_limit| {
+            let [p0, p1, p2] = self.corners[triangle as usize];
+            intersect_triangle(&triangle_ray, t_limit, p0, p1, p2).is_some()
+        })
+    }
+
+    /// Point, error bound and normals of a hit returned by [`Mesh::intersect`].
+    pub fn surface(&self, hit: &MeshHit) -> SurfaceHit {
+        let [p0, p1, p2] = self.corners[hit.triangle as usize];
+        let [b0, b1, b2] = hit.barycentrics;
+        let triangle_hit = TriangleHit {
+            t: hit.t,
+            b0,
+            b1,
+            b2,
+        };
+        triangle_surface(p0, p1, p2, self.vertex_normals(hit.triangle), &triangle_hit)
+    }
+
+    /// Corner positions of a triangle (in the mesh's order).
+    pub fn triangle(&self, index: u32) -> [Vec3; 3] {
+        self.corners[index as usize]
+    }
+
+    /// Unit corner normals of a triangle, or `None` when it is shaded with its geometric normal.
+    pub fn vertex_normals(&self, index: u32) -> Option<[Vec3; 3]> {
+        let normals = self.normal_indices[index as usize].map(|n| self.normals[n as usize]);
+        normals.iter().all(|&n| n != Vec3::ZERO).then_some(normals)
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.corners.len()
+    }
+
+    pub fn bounds(&self) -> Aabb {
+        self.bvh.bounds()
+    }
+
+    /// The acceleration structure, for statistics (node and leaf counts).
+    pub fn bvh(&self) -> &Bvh {
+        &self.bvh
+    }
+}
+
+fn validate(positions: &[Vec3], triangles: &[[u32; 3]]) -> Result<(), MeshError> {
+    if triangles.is_empty() {
+        return Err(MeshError::NoTriangles);
+    }
+    for count in [positions.len(), triangles.len()] {
+        if u32::try_from(count).is_err() {
+            return Err(MeshError::TooLarge { count });
+        }
+    }
+    if let Some(vertex) = positions.iter().position(|p| !p.is_finite()) {
+        return Err(MeshError::NonFinitePosition {
+            vertex,
+            position: positions[vertex],
+        });
+    }
+    for (triangle, corners) in triangles.iter().enumerate() {
+        if let Some(&index) = corners.iter().find(|&&i| i as usize >= positions.len()) {
+            let vertex_count = positions.len();
+            return Err(MeshError::VertexIndexOutOfRange {
+                triangle,
+                index,
+                vertex_count,
+            });
+        }
+    }
+    Ok(())
+}
+
+fn validate_normal_indices(
+    normals: &[Vec3],
+    normal_triangles: &[[u32; 3]],
+    triangle_count: usize,
+) -> Result<(), MeshError> {
+    if normal_triangles.len() != triangle_count {
+        let found = normal_triangles.len();
+        return Err(MeshError::NormalTriangleCount {
+            expected: triangle_count,
+            found,
+        });
+    }
+    for (triangle, corners) in normal_triangles.iter().enumerate() {
+        if let Some(&index) = corners.iter().find(|&&i| i as usize >= normals.len()) {
+            let normal_count = normals.len();
+            return Err(MeshError::NormalIndexOutOfRange {
+                triangle,
+                index,
+                normal_count,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// One unit normal per position, following [`VertexNormals::Averaged`]; zero where the sum
+/// cannot be normalised (no usable face, or faces cancelling out).
+fn averaged_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
+    let mut sums = vec![Vec3::ZERO; positions.len()];
+    for corners in triangles {
+        let [p0, p1, p2] = corners.map(|i| positions[i as usize]);
+        if let Some(normal) = face_normal(p0, p1, p2) {
+            for &vertex in corners {
+                sums[vertex as usize] += normal;
+            }
+        }
+    }
+    sums.into_iter()
+        .map(|sum| normalize(sum).unwrap_or(Vec3::ZERO))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Two triangles folded along the shared edge (0, 1).
+    fn roof() -> (Vec<Vec3>, Vec<[u32; 3]>) {
+        let positions = vec![
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(1.0, 0.0, -1.0),
+            Vec3::new(-1.0, 0.0, -1.0),
+        ];
+        (positions, vec![[0, 2, 1], [0, 1, 3]])
+    }
+
+    #[test]
+    fn rejects_invalid_data() {
+        let (positions, triangles) = roof();
+        let averaged = || VertexNormals::Averaged;
+        assert!(matches!(
+            Mesh::new(&positions, &[], averaged()),
+            Err(MeshError::NoTriangles)
+        ));
+        let out_of_range = Mesh::new(&positions, &[[0, 1, 4]], averaged());
+        assert!(matches!(
+            out_of_range,
+            Err(MeshError::VertexIndexOutOfRange { index: 4, .. })
+        ));
+        let mut nan = positions.clone();
+        nan[2].y = Real::NAN;
+        let non_finite = Mesh::new(&nan, &triangles, averaged());
+        assert!(matches!(
+            non_finite,
+            Err(MeshError::NonFinitePosition { vertex: 2, .. })
+        ));
+        let normals = VertexNormals::Indexed {
+            normals: vec![Vec3::Z],
+            triangles: vec![[0, 0, 1]],
+        };
+        let bad_normals = Mesh::new(&positions, &triangles[..1], normals);
+        assert!(matches!(
+            bad_normals,
+            Err(MeshError::NormalIndexOutOfRange { index: 1, .. })
+        ));
+    }
+
+    #[test]
+    fn averaged_normals_are_unweighted_sums_of_face_normals() {
+        let (positions, triangles) = roof();
+        let mesh = Mesh::new(&positions, &triangles, VertexNormals::Averaged).unwrap();
+        let face = |[a, b, c]: [u32; 3]| {
+            let p = |i: u32| positions[i as usize];
+            (p(b) - p(a)).cross(p(c) - p(a)).normalize()
+        };
+        let shared = (face(triangles[0]) + face(triangles[1])).normalize();
+        for index in 0..2 {
+            let corners = mesh.triangle(index);
+            let normals = mesh.vertex_normals(index).expect("usable normals");
+            for (corner, normal) in corners.iter().zip(normals) {
+                let expected = if corner.x == 0.0 {
+                    shared
+                } else {
+                    face(triangles[if corner.x > 0.0 { 0 } else { 1 }])
+                };
+                assert!(
+                    (normal - expected).length() < 1e-6,
+                    "{corner}: {normal} vs {expected}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn unusable_normals_fall_back_to_the_geometric_normal() {
+        let (positions, triangles) = roof();
+        let normals = VertexNormals::Indexed {
+            normals: vec![Vec3::Y, Vec3::ZERO, Vec3::NAN],
+            triangles: vec![[0, 0, 0], [0, 1, 0]],
+        };
+        let mesh = Mesh::new(&positions, &triangles, normals).unwrap();
+        let usable: Vec<bool> = (0..2).map(|i| mesh.vertex_normals(i).is_some()).collect();
+        assert_eq!(usable.iter().filter(|&&u| u).count(), 1);
+        let ray = Ray::new(Vec3::new(-0.3, 0.2, 5.0), Vec3::NEG_Z);
+        let hit = mesh.intersect(&ray, Real::INFINITY).expect("hit");
+        let surface = mesh.surface(&hit);
+        assert_eq!(mesh.vertex_normals(hit.triangle), None);
+        assert_eq!(surface.shading_normal, surface.geometric_normal);
+    }
+
+    #[test]
+    fn intersect_and_occluded() {
+        let (positions, triangles) = roof();
+        let mesh = Mesh::new(&positions, &triangles, VertexNormals::Averaged).unwrap();
+        let ray = Ray::new(Vec3::new(0.3, 0.2, 5.0), Vec3::NEG_Z);
+        let hit = mesh.intersect(&ray, Real::INFINITY).expect("hit");
+        assert!((hit.t - 5.3).abs() < 1e-5, "{hit:?}");
+        assert!(mesh.occluded(&ray, 6.0));
+        assert!(!mesh.occluded(&ray, 5.0));
+        assert_eq!(mesh.intersect(&ray, 5.0), None);
+        assert_eq!(mesh.triangle_count(), 2);
+        assert_eq!(
+            mesh.bounds(),
+            Aabb::new(Vec3::new(-1.0, 0.0, -1.0), Vec3::new(1.0, 1.0, 0.0))
+        );
+    }
+}

@@ -2,7 +2,9 @@
 
 pub mod aabb;
 pub mod bvh;
+pub mod generate;
 pub mod mesh;
+pub mod obj;
 pub mod ray;
 pub mod triangle;
 
