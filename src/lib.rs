@@ -3,7 +3,12 @@
 //! Data flows one way: case → scene → render → film → outputs → compare.
 
 pub mod case;
+pub mod error;
 pub mod film;
 pub mod geometry;
+pub mod pipeline;
 pub mod real;
 pub mod render;
+pub mod scene;
+
+pub use error::Error;

@@ -35,3 +35,9 @@ pub fn real(x: f64) -> Real {
 pub fn vec3(v: [f64; 3]) -> Vec3 {
     Vec3::new(real(v[0]), real(v[1]), real(v[2]))
 }
+
+/// Converts a transform composed in `f64` (as the case loader does) to the shading precision.
+#[inline]
+pub fn mat4(m: glam::DMat4) -> Mat4 {
+    m.as_mat4()
+}

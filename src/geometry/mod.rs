@@ -5,7 +5,11 @@ pub mod bvh;
 pub mod generate;
 pub mod mesh;
 pub mod obj;
+pub mod plane;
 pub mod ray;
+pub mod spawn;
+pub mod sphere;
+pub mod transform;
 pub mod triangle;
 
 pub use ray::{Ray, SurfaceHit};

@@ -1,6 +1,17 @@
 //! Turning a scene into a film: camera, lights, materials, sampling, the Whitted integrator and
 //! the supersampling filter.
 
+pub mod camera;
+pub mod integrator;
+pub mod light;
+pub mod material;
+pub mod progress;
+pub mod renderer;
+pub mod sampler;
+
+pub use progress::Progress;
+pub use renderer::{RenderOptions, render};
+
 use serde::Deserialize;
 
 /// Which camera and image conventions to follow.

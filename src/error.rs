@@ -1,0 +1,15 @@
+//! The library's top-level error: every stage's error, each of which already names its file.
+
+use crate::case::CaseError;
+use crate::film::OutputError;
+use crate::scene::BuildError;
+
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    #[error(transparent)]
+    Case(#[from] CaseError),
+    #[error(transparent)]
+    Build(#[from] BuildError),
+    #[error(transparent)]
+    Output(#[from] OutputError),
+}

@@ -1,0 +1,76 @@
+//! Robust ray spawning: secondary rays start just far enough off the surface that rounding can
+//! never put their origin on the wrong side, which no fixed epsilon can promise at every scale
+//! (pbrt-v4 `OffsetRayOrigin`).
+
+use super::ray::{Ray, SurfaceHit};
+use crate::real::{Real, Vec3};
+
+/// Shadow rays to a point stop this fraction short of it, so that a light sitting on a surface
+/// is not shadowed by that surface. Relative, so it scales with the scene.
+pub const SHADOW_RAY_SHORTFALL: Real = 1.0e-4;
+
+/// Moves `point` along the geometric normal, to the side `direction` leaves towards, by the
+/// projection of its error box on the normal, then one more ulp away so that the rounding of
+/// the addition cannot undo it.
+pub fn spawn_ray_offset(hit: &SurfaceHit, direction: Vec3) -> Vec3 {
+    let normal = hit.geometric_normal;
+    let distance = normal.abs().dot(hit.point_error);
+    let mut offset = normal * distance;
+    if direction.dot(normal) < 0.0 {
+        offset = -offset;
+    }
+    let mut origin = hit.point + offset;
+    for axis in 0..3 {
+        if offset[axis] > 0.0 {
+            origin[axis] = origin[axis].next_up();
+        } else if offset[axis] < 0.0 {
+            origin[axis] = origin[axis].next_down();
+        }
+    }
+    origin
+}
+
+pub fn spawn_ray(hit: &SurfaceHit, direction: Vec3) -> Ray {
+    Ray::new(spawn_ray_offset(hit, direction), direction)
+}
+
+/// A ray towards `target` whose parameter reaches the target at `t = 1`; returns the ray and
+/// the `t_max` that stops it just short of the target.
+pub fn spawn_ray_to(hit: &SurfaceHit, target: Vec3) -> (Ray, Real) {
+    let origin = spawn_ray_offset(hit, target - hit.point);
+    (Ray::new(origin, target - origin), 1.0 - SHADOW_RAY_SHORTFALL)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn hit_at(point: Vec3, error: Vec3) -> SurfaceHit {
+        SurfaceHit { t: 1.0, point, point_error: error, geometric_normal: Vec3::Y, shading_normal: Vec3::Y }
+    }
+
+    #[test]
+    fn origin_moves_to_the_side_the_ray_leaves_by() {
+        let hit = hit_at(Vec3::new(1.0e6, 2.0, 0.0), Vec3::splat(1.0e-3));
+        let up = spawn_ray(&hit, Vec3::new(0.0, 1.0, 1.0));
+        assert!(up.origin.y > 2.0 + 1.0e-3);
+        let down = spawn_ray(&hit, Vec3::new(0.0, -1.0, 1.0));
+        assert!(down.origin.y < 2.0 - 1.0e-3);
+        assert_eq!(up.origin.x, 1.0e6, "only the normal direction moves");
+    }
+
+    #[test]
+    fn an_offset_lost_to_rounding_still_moves_one_ulp() {
+        let hit = hit_at(Vec3::new(0.0, 1.0, 0.0), Vec3::splat(1.0e-12));
+        let ray = spawn_ray(&hit, Vec3::Y);
+        assert_eq!(ray.origin.y, (1.0 as Real).next_up());
+    }
+
+    #[test]
+    fn rays_to_a_point_stop_short_of_it() {
+        let hit = hit_at(Vec3::ZERO, Vec3::splat(1.0e-6));
+        let (ray, t_max) = spawn_ray_to(&hit, Vec3::new(0.0, 4.0, 0.0));
+        let end = ray.at(t_max);
+        assert!(end.y < 4.0 && end.y > 3.99);
+    }
+}

@@ -1,0 +1,146 @@
+//! Affine transforms for instancing: rays go to object space, hits come back to world space with
+//! their error bounds widened by the transformation's own rounding.
+
+use super::aabb::Aabb;
+use super::ray::{Ray, SurfaceHit};
+use crate::real::{Mat3, Mat4, Real, Vec3, gamma};
+
+#[derive(Clone, Debug)]
+pub struct Transform {
+    object_to_world: Mat4,
+    world_to_object: Mat4,
+    /// Inverse transpose of the linear part: normals stay perpendicular to surfaces under
+    /// non-uniform scale.
+    normal_to_world: Mat3,
+}
+
+/// Why a transform cannot be used.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+pub enum TransformError {
+    #[error("the transform is singular (it flattens space, e.g. a zero scale), so it has no inverse")]
+    Singular,
+    #[error("the transform is not affine (its bottom row is not 0 0 0 1)")]
+    NotAffine,
+    #[error("the transform has a non-finite entry")]
+    NotFinite,
+}
+
+impl Transform {
+    /// Fails for matrices whose inverse would be meaningless, instead of producing NaN pictures:
+    /// the determinant is compared with the scale of the matrix so that a tiny but well-shaped
+    /// scene (every entry 1e-4) is accepted while a flattened one is not.
+    pub fn new(object_to_world: Mat4) -> Result<Self, TransformError> {
+        if !object_to_world.is_finite() {
+            return Err(TransformError::NotFinite);
+        }
+        let bottom = object_to_world.row(3);
+        if bottom != glam::Vec4::W {
+            return Err(TransformError::NotAffine);
+        }
+        let linear = Mat3::from_mat4(object_to_world);
+        let scale = linear.to_cols_array().iter().fold(0.0 as Real, |m, v| m.max(v.abs()));
+        let determinant = linear.determinant();
+        if scale == 0.0 || !(determinant.abs() > 1.0e3 * Real::EPSILON * scale * scale * scale) {
+            return Err(TransformError::Singular);
+        }
+        let world_to_object = object_to_world.inverse();
+        if !world_to_object.is_finite() {
+            return Err(TransformError::Singular);
+        }
+        let normal_to_world = linear.inverse().transpose();
+        Ok(Transform { object_to_world, world_to_object, normal_to_world })
+    }
+
+    pub fn object_to_world(&self) -> &Mat4 {
+        &self.object_to_world
+    }
+
+    pub fn ray_to_object(&self, ray: &Ray) -> Ray {
+        Ray::new(
+            self.world_to_object.transform_point3(ray.origin),
+            self.world_to_object.transform_vector3(ray.direction),
+        )
+    }
+
+    pub fn point_to_world(&self, point: Vec3) -> Vec3 {
+        self.object_to_world.transform_point3(point)
+    }
+
+    pub fn vector_to_world(&self, vector: Vec3) -> Vec3 {
+        self.object_to_world.transform_vector3(vector)
+    }
+
+    /// Unit world normal; a normal that degenerates (it cannot for a non-singular transform,
+    /// but rounding is rounding) keeps the object-space direction rather than becoming NaN.
+    pub fn normal_to_world(&self, normal: Vec3) -> Vec3 {
+        (self.normal_to_world * normal).try_normalize().unwrap_or(normal)
+    }
+
+    /// The error bound follows pbrt-v4's `Transform::operator()(Point3fi)`: the rounding of the
+    /// matrix product itself, plus the incoming error carried through `|M|`.
+    pub fn hit_to_world(&self, hit: &SurfaceHit) -> SurfaceHit {
+        let point = self.point_to_world(hit.point);
+        let abs_linear = Mat3::from_mat4(self.object_to_world).abs();
+        let translation = self.object_to_world.w_axis.truncate().abs();
+        let point_error = gamma(3) * (abs_linear * hit.point.abs() + translation)
+            + (1.0 + gamma(3)) * (abs_linear * hit.point_error);
+        SurfaceHit {
+            t: hit.t,
+            point,
+            point_error,
+            geometric_normal: self.normal_to_world(hit.geometric_normal),
+            shading_normal: self.normal_to_world(hit.shading_normal),
+        }
+    }
+
+    /// World bounds of an object-space box: the box of its eight transformed corners.
+    pub fn bounds_to_world(&self, bounds: &Aabb) -> Aabb {
+        let mut world = Aabb::EMPTY;
+        for corner in 0..8 {
+            let pick = |bit: usize, lo: Real, hi: Real| if corner & bit == 0 { lo } else { hi };
+            let p = Vec3::new(
+                pick(1, bounds.min.x, bounds.max.x),
+                pick(2, bounds.min.y, bounds.max.y),
+                pick(4, bounds.min.z, bounds.max.z),
+            );
+            world = world.grow(self.point_to_world(p));
+        }
+        world
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rejects_singular_and_accepts_tiny_scales() {
+        let flat = Mat4::from_scale(Vec3::new(1.0, 0.0, 1.0));
+        assert_eq!(Transform::new(flat).unwrap_err(), TransformError::Singular);
+        let tiny = Mat4::from_scale(Vec3::splat(1.0e-4));
+        assert!(Transform::new(tiny).is_ok());
+        let nan = Mat4::from_scale(Vec3::new(Real::NAN, 1.0, 1.0));
+        assert_eq!(Transform::new(nan).unwrap_err(), TransformError::NotFinite);
+    }
+
+    #[test]
+    fn normals_use_the_inverse_transpose() {
+        let squash = Transform::new(Mat4::from_scale(Vec3::new(1.0, 0.2, 1.0))).unwrap();
+        let diagonal = Vec3::new(1.0, 1.0, 0.0).normalize();
+        let world = squash.normal_to_world(diagonal);
+        assert!((world - Vec3::new(0.2, 1.0, 0.0).normalize()).length() < 1e-6);
+    }
+
+    #[test]
+    fn ray_parameter_is_preserved_through_object_space() {
+        let transform = Transform::new(
+            Mat4::from_translation(Vec3::new(1.0, 2.0, 3.0)) * Mat4::from_scale(Vec3::new(2.0, 3.0, 4.0)),
+        )
+        .unwrap();
+        let ray = Ray::new(Vec3::new(-5.0, 1.0, 2.0), Vec3::new(1.0, 0.25, 0.1));
+        let local = transform.ray_to_object(&ray);
+        let t = 3.0;
+        let back = transform.point_to_world(local.at(t));
+        assert!((back - ray.at(t)).length() < 1e-5);
+    }
+}

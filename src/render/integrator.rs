@@ -1,0 +1,74 @@
+//! Whitted recursion, unrolled: with only mirror reflection, each hit spawns at most one new
+//! ray, so the "recursion" is a loop that carries the product of specular colours. That makes
+//! `bounces = 64` (or 1024) cost nothing on the stack.
+
+use crate::geometry::Ray;
+use crate::geometry::spawn::{spawn_ray, spawn_ray_to};
+use crate::real::{Color, Real, Vec3};
+use crate::scene::{Intersection, Scene};
+
+pub struct Whitted<'a> {
+    scene: &'a Scene,
+    bounces: u32,
+    shadows: bool,
+}
+
+impl<'a> Whitted<'a> {
+    pub fn new(scene: &'a Scene, bounces: u32, shadows: bool) -> Self {
+        Whitted { scene, bounces, shadows }
+    }
+
+    /// The colour seen along a primary ray, and what that ray hit first (for the AOVs).
+    pub fn trace(&self, primary: Ray) -> (Color, Option<Intersection>) {
+        let scene = self.scene;
+        let mut color = Color::ZERO;
+        let mut throughput = Color::ONE;
+        let mut ray = primary;
+        let mut first = None;
+        for depth in 0..=self.bounces {
+            let Some(hit) = scene.geometry.intersect(&ray) else {
+                color += throughput * scene.background.radiance(ray.direction);
+                break;
+            };
+            if depth == 0 {
+                first = Some(hit);
+            }
+            let material = &scene.materials[hit.material as usize];
+            color += throughput * self.direct_light(&ray, &hit);
+            if depth == self.bounces || !material.reflects() {
+                break;
+            }
+            throughput *= material.specular;
+            let normal = hit.surface.shading_normal;
+            let incoming = ray.direction.normalize();
+            let reflected = incoming - 2.0 * incoming.dot(normal) * normal;
+            ray = spawn_ray(&hit.surface, reflected);
+        }
+        (color, first)
+    }
+
+    /// Ambient plus every light that reaches the point (all of them without `shadows`).
+    fn direct_light(&self, ray: &Ray, hit: &Intersection) -> Color {
+        let scene = self.scene;
+        let material = &scene.materials[hit.material as usize];
+        let surface = &hit.surface;
+        let to_eye = -ray.direction.normalize();
+        let mut color = scene.ambient * material.diffuse;
+        for light in &scene.lights {
+            let incident = light.incident(surface.point);
+            if self.shadows && self.blocked(hit, incident.to_light, incident.position) {
+                continue;
+            }
+            color += material.shade(surface.shading_normal, incident.to_light, to_eye, incident.intensity);
+        }
+        color
+    }
+
+    fn blocked(&self, hit: &Intersection, to_light: Vec3, position: Option<Vec3>) -> bool {
+        let (shadow_ray, t_max) = match position {
+            Some(position) => spawn_ray_to(&hit.surface, position),
+            None => (spawn_ray(&hit.surface, to_light), Real::INFINITY),
+        };
+        self.scene.geometry.occluded(&shadow_ray, t_max)
+    }
+}

@@ -1,0 +1,140 @@
+//! The render loop: bands of rows in parallel, every pixel a pure function of the scene, the
+//! options and its coordinates, so the film is bit-identical for any thread count.
+
+use rayon::prelude::*;
+
+use super::Filter;
+use super::integrator::Whitted;
+use super::progress::Progress;
+use super::sampler::Sampler;
+use crate::film::Film;
+use crate::real::{Color, Real, Vec2, Vec3};
+use crate::scene::{Intersection, Scene};
+
+/// Rows per parallel work item: small enough to balance two cores on a 100-row image, large
+/// enough that scheduling costs nothing.
+const BAND_ROWS: usize = 4;
+
+/// The [1 2 1]⊗[1 2 1]/16 kernel over each output pixel's 3×3 block of supersamples.
+const GAUSSIAN_WEIGHTS: [Real; 3] = [0.25, 0.5, 0.25];
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RenderOptions {
+    pub width: u32,
+    pub height: u32,
+    pub bounces: u32,
+    pub shadows: bool,
+    pub samples: u32,
+    pub seed: u64,
+    pub filter: Filter,
+}
+
+pub fn render(scene: &Scene, options: &RenderOptions, progress: &Progress) -> Film {
+    let mut film = Film::new(options.width, options.height);
+    let pixels = PixelRenderer {
+        scene,
+        integrator: Whitted::new(scene, options.bounces, options.shadows),
+        sampler: Sampler::new(options.samples, options.seed),
+        options,
+    };
+    let width = options.width as usize;
+    let band = width * BAND_ROWS;
+    film.color
+        .par_chunks_mut(band)
+        .zip(film.depth.par_chunks_mut(band))
+        .zip(film.normal.par_chunks_mut(band))
+        .enumerate()
+        .for_each(|(band_index, ((color, depth), normal))| {
+            for (offset, ((color, depth), normal)) in color.iter_mut().zip(depth).zip(normal).enumerate() {
+                let index = band_index * band + offset;
+                let (x, y) = ((index % width) as u32, (index / width) as u32);
+                let pixel = pixels.pixel(x, y);
+                *color = film_vector(pixel.color);
+                *depth = pixel.depth;
+                *normal = pixel.normal;
+            }
+            progress.advance((color.len() / width) as u64);
+        });
+    progress.finish();
+    film
+}
+
+struct Pixel {
+    color: Color,
+    depth: f32,
+    normal: [f32; 3],
+}
+
+struct PixelRenderer<'a> {
+    scene: &'a Scene,
+    integrator: Whitted<'a>,
+    sampler: Sampler,
+    options: &'a RenderOptions,
+}
+
+impl PixelRenderer<'_> {
+    fn pixel(&self, x: u32, y: u32) -> Pixel {
+        let (width, height) = (self.options.width, self.options.height);
+        let centre = Vec2::new(x as Real + 0.5, y as Real + 0.5);
+        match self.options.filter {
+            Filter::None if self.sampler.samples_per_pixel() == 1 => {
+                let (color, first) = self.integrator.trace(self.scene.camera.ray(centre, width, height));
+                Pixel::new(color, first.as_ref())
+            }
+            Filter::None => {
+                let color = self.samples(x, y, width, height);
+                Pixel::new(color, self.first_hit(centre).as_ref())
+            }
+            Filter::Gaussian => {
+                let mut color = Color::ZERO;
+                for (j, wy) in GAUSSIAN_WEIGHTS.iter().enumerate() {
+                    for (i, wx) in GAUSSIAN_WEIGHTS.iter().enumerate() {
+                        let sub = self.samples(3 * x + i as u32, 3 * y + j as u32, 3 * width, 3 * height);
+                        color += sub * (wx * wy);
+                    }
+                }
+                Pixel::new(color, self.first_hit(centre).as_ref())
+            }
+        }
+    }
+
+    /// Mean colour of a (sub)pixel's stratified samples in an image of `width × height`.
+    fn samples(&self, x: u32, y: u32, width: u32, height: u32) -> Color {
+        let count = self.sampler.samples_per_pixel();
+        let origin = Vec2::new(x as Real, y as Real);
+        let sum = (0..count).fold(Color::ZERO, |sum, index| {
+            let raster = origin + self.sampler.offset(x, y, index);
+            sum + self.integrator.trace(self.scene.camera.ray(raster, width, height)).0
+        });
+        sum / count as Real
+    }
+
+    /// The AOVs come from one ray through the output pixel's centre: depth and normals averaged
+    /// across an edge would describe no surface at all.
+    fn first_hit(&self, centre: Vec2) -> Option<Intersection> {
+        let ray = self.scene.camera.ray(centre, self.options.width, self.options.height);
+        self.scene.geometry.intersect(&ray)
+    }
+}
+
+impl Pixel {
+    fn new(color: Color, first: Option<&Intersection>) -> Pixel {
+        match first {
+            Some(hit) => Pixel {
+                color,
+                depth: hit.surface.t as f32,
+                normal: film_vector(hit.surface.shading_normal),
+            },
+            None => Pixel { color, depth: f32::INFINITY, normal: [0.0; 3] },
+        }
+    }
+}
+
+/// No NaN or infinity may reach a file: a value that overflowed `f32` is clamped to the
+/// largest finite one and a NaN (which valid input cannot produce) becomes zero.
+fn film_vector(v: Vec3) -> [f32; 3] {
+    v.to_array().map(|c| {
+        let c = c as f32;
+        if c.is_nan() { 0.0 } else { c.clamp(-f32::MAX, f32::MAX) }
+    })
+}

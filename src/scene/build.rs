@@ -1,0 +1,213 @@
+//! Case → scene: flattens groups, composes transforms, loads each mesh once, and keeps only the
+//! work the scene needs (no transform on untransformed shapes, no BVH for a handful of objects).
+
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use glam::{DMat4, DVec3};
+
+use super::{Aggregate, Background, CubeMap, CubeMapError, Object, Scene, Shape, Triangle};
+use crate::case::{Case, LightSpec, ObjectSpec, ShapeSpec, SourceLocation, composite_matrix};
+use crate::geometry::mesh::{Mesh, MeshError, NormalSource};
+use crate::geometry::plane::Plane;
+use crate::geometry::sphere::Sphere;
+use crate::geometry::transform::{Transform, TransformError};
+use crate::real::{mat4, real, vec3};
+use crate::render::Profile;
+use crate::render::camera::Camera;
+use crate::render::light::Light;
+use crate::render::material::Material;
+
+#[derive(Debug, thiserror::Error)]
+pub enum BuildError {
+    #[error("{location}: cannot load mesh: {source}")]
+    Mesh { location: SourceLocation, source: MeshError },
+    #[error("{location}: {source}")]
+    Transform { location: SourceLocation, source: TransformError },
+    #[error("{file}: {source}")]
+    CubeMap { file: PathBuf, source: CubeMapError },
+}
+
+pub fn build_scene(case: &Case) -> Result<Scene, BuildError> {
+    let camera_spec = &case.camera;
+    let camera = Camera::new(
+        case.render.profile,
+        vec3(camera_spec.center),
+        vec3(camera_spec.direction),
+        vec3(camera_spec.up),
+        real(camera_spec.fov),
+    );
+    let background = match &case.background.cube_map {
+        Some(dir) => Background::CubeMap(
+            CubeMap::load(dir).map_err(|source| BuildError::CubeMap { file: case.path.clone(), source })?,
+        ),
+        None => Background::Color(vec3(case.background.color)),
+    };
+    let mut materials: Vec<Material> = case
+        .materials
+        .iter()
+        .map(|m| Material { diffuse: vec3(m.diffuse), specular: vec3(m.specular), shininess: real(m.shininess) })
+        .collect();
+    let default_material = materials.len() as u32;
+    let mut builder = Builder {
+        normals: match case.render.profile {
+            Profile::Native => NormalSource::FromFileOrAveraged,
+            Profile::Mit6837 => NormalSource::Averaged,
+        },
+        default_material,
+        meshes: HashMap::new(),
+        objects: Vec::new(),
+        planes: Vec::new(),
+        uses_default_material: false,
+    };
+    for spec in &case.objects {
+        builder.add(spec, None, None)?;
+    }
+    if builder.uses_default_material {
+        materials.push(Material::default());
+    }
+    Ok(Scene {
+        camera,
+        background,
+        ambient: vec3(case.background.ambient),
+        lights: case.lights.iter().map(light).collect(),
+        materials,
+        geometry: Aggregate::new(builder.objects, builder.planes),
+    })
+}
+
+fn light(spec: &LightSpec) -> Light {
+    match *spec {
+        LightSpec::Point { position, color, falloff } => {
+            Light::Point { position: vec3(position), color: vec3(color), falloff: real(falloff) }
+        }
+        LightSpec::Directional { direction, color } => {
+            Light::Directional { direction: vec3(direction).normalize(), color: vec3(color) }
+        }
+    }
+}
+
+struct Builder {
+    normals: NormalSource,
+    default_material: u32,
+    meshes: HashMap<PathBuf, Arc<Mesh>>,
+    objects: Vec<Object>,
+    planes: Vec<(Plane, u32)>,
+    uses_default_material: bool,
+}
+
+impl Builder {
+    /// `parent` is the composed transform of the enclosing groups, `None` for the identity.
+    fn add(&mut self, spec: &ObjectSpec, parent: Option<DMat4>, inherited: Option<u32>) -> Result<(), BuildError> {
+        let material = spec.material.map(|m| m as u32).or(inherited);
+        let matrix = match (parent, spec.transform.is_empty()) {
+            (parent, true) => parent,
+            (None, false) => Some(composite_matrix(&spec.transform)),
+            (Some(parent), false) => Some(parent * composite_matrix(&spec.transform)),
+        };
+        let transform_error = |source| BuildError::Transform { location: spec.location.clone(), source };
+        if let ShapeSpec::Group { objects } = &spec.shape {
+            for child in objects {
+                self.add(child, matrix, material)?;
+            }
+            return Ok(());
+        }
+        let material = material.unwrap_or_else(|| {
+            self.uses_default_material = true;
+            self.default_material
+        });
+        match &spec.shape {
+            ShapeSpec::Group { .. } => unreachable!("groups returned above"),
+            ShapeSpec::Plane { normal, offset } => {
+                let plane = transformed_plane(DVec3::from(*normal), *offset, matrix).map_err(transform_error)?;
+                self.planes.push((plane, material));
+            }
+            ShapeSpec::Triangle { vertices, normals } => {
+                let triangle = transformed_triangle(vertices, normals.as_ref(), matrix).map_err(transform_error)?;
+                self.objects.push(Object { shape: Shape::Triangle(triangle), transform: None, material });
+            }
+            ShapeSpec::Sphere { center, radius } => {
+                let shape = Shape::Sphere(Sphere { center: vec3(*center), radius: real(*radius) });
+                self.push_instanced(shape, matrix, material).map_err(transform_error)?;
+            }
+            ShapeSpec::Mesh { obj } => {
+                let mesh = self.mesh(obj).map_err(|source| BuildError::Mesh { location: spec.location.clone(), source })?;
+                self.push_instanced(Shape::Mesh(mesh), matrix, material).map_err(transform_error)?;
+            }
+        }
+        Ok(())
+    }
+
+    fn push_instanced(&mut self, shape: Shape, matrix: Option<DMat4>, material: u32) -> Result<(), TransformError> {
+        let transform = matrix.map(|m| Transform::new(mat4(m)).map(Arc::new)).transpose()?;
+        self.objects.push(Object { shape, transform, material });
+        Ok(())
+    }
+
+    /// A mesh used by several objects is loaded and its BVH built once.
+    fn mesh(&mut self, path: &Path) -> Result<Arc<Mesh>, MeshError> {
+        if let Some(mesh) = self.meshes.get(path) {
+            return Ok(mesh.clone());
+        }
+        let mesh = Arc::new(Mesh::load_obj(path, self.normals)?);
+        self.meshes.insert(path.to_path_buf(), mesh.clone());
+        Ok(mesh)
+    }
+}
+
+/// Planes stay analytic under any affine transform: the normal goes by the inverse transpose
+/// and a point on the plane by the matrix, so no instancing is needed.
+fn transformed_plane(normal: DVec3, offset: f64, matrix: Option<DMat4>) -> Result<Plane, TransformError> {
+    let Some(matrix) = matrix else {
+        return Ok(Plane::new(vec3(normal.to_array()), real(offset)));
+    };
+    let inverse_transpose = inverse_linear(matrix)?.transpose();
+    let point = matrix.transform_point3(normal * (offset / normal.length_squared()));
+    let world_normal = (inverse_transpose * normal).normalize();
+    Ok(Plane::new(vec3(world_normal.to_array()), real(world_normal.dot(point))))
+}
+
+/// Lone triangles are moved to world space once rather than instanced.
+fn transformed_triangle(
+    vertices: &[[f64; 3]; 3],
+    normals: Option<&[[f64; 3]; 3]>,
+    matrix: Option<DMat4>,
+) -> Result<Triangle, TransformError> {
+    let matrix = matrix.unwrap_or(DMat4::IDENTITY);
+    let inverse_transpose = inverse_linear(matrix)?.transpose();
+    let vertices = vertices.map(|v| vec3(matrix.transform_point3(DVec3::from(v)).to_array()));
+    let normals = normals.map(|ns| ns.map(|n| vec3((inverse_transpose * DVec3::from(n)).normalize_or_zero().to_array())));
+    Ok(Triangle { vertices, normals })
+}
+
+/// The inverse of the linear part, checked the same way instance transforms are.
+fn inverse_linear(matrix: DMat4) -> Result<glam::DMat3, TransformError> {
+    Transform::new(mat4(matrix))?;
+    Ok(glam::DMat3::from_mat4(matrix).inverse())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    use crate::real::Vec3;
+
+    #[test]
+    fn transformed_plane_moves_with_its_matrix() {
+        let lift = DMat4::from_translation(DVec3::new(0.0, 3.0, 0.0));
+        let plane = transformed_plane(DVec3::Y, -2.0, Some(lift)).unwrap();
+        assert!((plane.normal - Vec3::Y).length() < 1e-6);
+        assert!((plane.offset - 1.0).abs() < 1e-6);
+        let tilt = DMat4::from_scale(DVec3::new(1.0, 2.0, 1.0)) * DMat4::from_rotation_z(45f64.to_radians());
+        let plane = transformed_plane(DVec3::Y, 1.0, Some(tilt)).unwrap();
+        let on_plane = tilt.transform_point3(DVec3::new(0.0, 1.0, 0.0));
+        assert!((plane.normal.dot(vec3(on_plane.to_array())) - plane.offset).abs() < 1e-5);
+    }
+
+    #[test]
+    fn singular_transform_is_an_error_not_a_nan() {
+        let flat = DMat4::from_scale(DVec3::new(1.0, 0.0, 1.0));
+        assert!(transformed_plane(DVec3::Y, 0.0, Some(flat)).is_err());
+    }
+}

@@ -1,0 +1,42 @@
+//! A scene ready to render: built once from a case, immutable while rendering.
+
+mod aggregate;
+mod build;
+mod cube_map;
+mod object;
+
+pub use aggregate::{Aggregate, Intersection};
+pub use build::{BuildError, build_scene};
+pub use cube_map::{CubeMap, CubeMapError};
+pub use object::{Object, Shape, ShapeHit, Triangle};
+
+use crate::render::camera::Camera;
+use crate::render::light::Light;
+use crate::render::material::Material;
+use crate::real::{Color, Vec3};
+
+/// What a ray that hits nothing sees.
+#[derive(Debug)]
+pub enum Background {
+    Color(Color),
+    CubeMap(CubeMap),
+}
+
+impl Background {
+    pub fn radiance(&self, direction: Vec3) -> Color {
+        match self {
+            Background::Color(color) => *color,
+            Background::CubeMap(map) => map.radiance(direction),
+        }
+    }
+}
+
+#[derive(Debug)]
+pub struct Scene {
+    pub camera: Camera,
+    pub background: Background,
+    pub ambient: Color,
+    pub lights: Vec<Light>,
+    pub materials: Vec<Material>,
+    pub geometry: Aggregate,
+}
