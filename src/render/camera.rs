@@ -98,7 +98,7 @@ mod tests {
     fn mit6837_uses_up_as_given() {
         let tilted_up = Vec3::new(0.0, 2.0, 1.0);
         let cam = Camera::new(Profile::Mit6837, Vec3::ZERO, -Vec3::Z, tilted_up, 90.0);
-        let top_centre = cam.ray(Vec2::new(1.0, 0.5), 3, 3);
+        let top_centre = cam.ray(Vec2::new(1.5, 0.5), 3, 3);
         let expected = (-Vec3::Z + tilted_up).normalize();
         assert!((top_centre.direction - expected).length() < 1e-6);
     }
