@@ -41,3 +41,10 @@ pub fn vec3(v: [f64; 3]) -> Vec3 {
 pub fn mat4(m: glam::DMat4) -> Mat4 {
     m.as_mat4()
 }
+
+/// Narrows a shading value to the film's `f32`; a no-op in the default precision.
+#[inline]
+#[allow(clippy::unnecessary_cast)]
+pub fn to_f32(x: Real) -> f32 {
+    x as f32
+}

@@ -27,8 +27,9 @@ pub enum TransformError {
 
 impl Transform {
     /// Fails for matrices whose inverse would be meaningless, instead of producing NaN pictures:
-    /// the determinant is compared with the scale of the matrix so that a tiny but well-shaped
-    /// scene (every entry 1e-4) is accepted while a flattened one is not.
+    /// the determinant is compared with the cube of the largest entry, so a tiny but well-shaped
+    /// scene (every entry 1e-4) is accepted, and so is a squash by 1e-4 along one axis, while a
+    /// squash beyond ~1e5 (where an `f32` inverse keeps no correct digit) is not.
     pub fn new(object_to_world: Mat4) -> Result<Self, TransformError> {
         if !object_to_world.is_finite() {
             return Err(TransformError::NotFinite);
@@ -40,7 +41,8 @@ impl Transform {
         let linear = Mat3::from_mat4(object_to_world);
         let scale = linear.to_cols_array().iter().fold(0.0 as Real, |m, v| m.max(v.abs()));
         let determinant = linear.determinant();
-        if scale == 0.0 || !(determinant.abs() > 1.0e3 * Real::EPSILON * scale * scale * scale) {
+        let threshold = 64.0 * Real::EPSILON * scale * scale * scale;
+        if scale == 0.0 || determinant.is_nan() || determinant.abs() <= threshold {
             return Err(TransformError::Singular);
         }
         let world_to_object = object_to_world.inverse();
@@ -119,6 +121,10 @@ mod tests {
         assert_eq!(Transform::new(flat).unwrap_err(), TransformError::Singular);
         let tiny = Mat4::from_scale(Vec3::splat(1.0e-4));
         assert!(Transform::new(tiny).is_ok());
+        let squashed = Mat4::from_scale(Vec3::new(1.0, 1.0e-4, 1.0));
+        assert!(Transform::new(squashed).is_ok());
+        let flattened = Mat4::from_scale(Vec3::new(1.0, 1.0e-6, 1.0));
+        assert_eq!(Transform::new(flattened).unwrap_err(), TransformError::Singular);
         let nan = Mat4::from_scale(Vec3::new(Real::NAN, 1.0, 1.0));
         assert_eq!(Transform::new(nan).unwrap_err(), TransformError::NotFinite);
     }

@@ -8,7 +8,7 @@ use super::integrator::Whitted;
 use super::progress::Progress;
 use super::sampler::Sampler;
 use crate::film::Film;
-use crate::real::{Color, Real, Vec2, Vec3};
+use crate::real::{Color, Real, Vec2, Vec3, to_f32};
 use crate::scene::{Intersection, Scene};
 
 /// Rows per parallel work item: small enough to balance two cores on a 100-row image, large
@@ -122,7 +122,7 @@ impl Pixel {
         match first {
             Some(hit) => Pixel {
                 color,
-                depth: hit.surface.t as f32,
+                depth: to_f32(hit.surface.t),
                 normal: film_vector(hit.surface.shading_normal),
             },
             None => Pixel { color, depth: f32::INFINITY, normal: [0.0; 3] },
@@ -134,7 +134,7 @@ impl Pixel {
 /// largest finite one and a NaN (which valid input cannot produce) becomes zero.
 fn film_vector(v: Vec3) -> [f32; 3] {
     v.to_array().map(|c| {
-        let c = c as f32;
+        let c = to_f32(c);
         if c.is_nan() { 0.0 } else { c.clamp(-f32::MAX, f32::MAX) }
     })
 }

@@ -39,9 +39,9 @@ pub fn build_scene(case: &Case) -> Result<Scene, BuildError> {
         real(camera_spec.fov),
     );
     let background = match &case.background.cube_map {
-        Some(dir) => Background::CubeMap(
+        Some(dir) => Background::CubeMap(Box::new(
             CubeMap::load(dir).map_err(|source| BuildError::CubeMap { file: case.path.clone(), source })?,
-        ),
+        )),
         None => Background::Color(vec3(case.background.color)),
     };
     let mut materials: Vec<Material> = case

@@ -19,7 +19,8 @@ use crate::real::{Color, Vec3};
 #[derive(Debug)]
 pub enum Background {
     Color(Color),
-    CubeMap(CubeMap),
+    /// Boxed: a cube map is large and most scenes have a plain colour.
+    CubeMap(Box<CubeMap>),
 }
 
 impl Background {

@@ -1,0 +1,76 @@
+//! Throughput and end-to-end benchmarks.
+//!
+//! - `primary_rays/blob_1.3M`: camera rays into a 1,310,720-triangle mesh that fills the frame,
+//!   on one thread (per-core figure) and on all cores; criterion reports rays/s as elements/s.
+//! - `end_to_end/*`: load, build and render shipped cases (no file writes).
+
+use std::path::Path;
+use std::sync::Arc;
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use goldray::case::{LoadOptions, load};
+use goldray::geometry::generate::blob;
+use goldray::geometry::mesh::{Mesh, VertexNormals};
+use goldray::pipeline::render_case;
+use goldray::real::{Color, Vec3};
+use goldray::render::camera::Camera;
+use goldray::render::material::Material;
+use goldray::render::{Filter, Profile, Progress, RenderOptions, render};
+use goldray::scene::{Aggregate, Background, Object, Scene, Shape};
+
+const SIDE: u32 = 256;
+
+fn blob_scene() -> Scene {
+    let (positions, triangles) = blob(8, 1);
+    let mesh = Mesh::new(&positions, &triangles, VertexNormals::Averaged).expect("the blob is a valid mesh");
+    let object = Object { shape: Shape::Mesh(Arc::new(mesh)), transform: None, material: 0 };
+    Scene {
+        camera: Camera::new(Profile::Native, Vec3::new(0.0, 0.0, 2.6), -Vec3::Z, Vec3::Y, 40.0),
+        background: Background::Color(Color::ZERO),
+        ambient: Color::ONE,
+        lights: Vec::new(),
+        materials: vec![Material::default()],
+        geometry: Aggregate::new(vec![object], Vec::new()),
+    }
+}
+
+fn primary_rays(c: &mut Criterion) {
+    let scene = blob_scene();
+    let options = RenderOptions {
+        width: SIDE,
+        height: SIDE,
+        bounces: 0,
+        shadows: false,
+        samples: 1,
+        seed: 0,
+        filter: Filter::None,
+    };
+    let mut group = c.benchmark_group("primary_rays");
+    group.sample_size(10);
+    group.throughput(Throughput::Elements(u64::from(SIDE * SIDE)));
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a thread pool");
+        group.bench_function(format!("blob_1.3M/{threads}_threads"), |b| {
+            b.iter(|| pool.install(|| render(&scene, &options, &Progress::hidden())))
+        });
+    }
+    group.finish();
+}
+
+fn end_to_end(c: &mut Criterion) {
+    let mut group = c.benchmark_group("end_to_end");
+    group.sample_size(10);
+    for name in ["spheres_shadows", "blob_mesh"] {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases").join(format!("{name}.toml"));
+        group.bench_function(name, |b| {
+            b.iter(|| {
+                let case = load(&path, &LoadOptions::default()).expect("a shipped case loads");
+                render_case(&case, false).expect("a shipped case renders")
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, primary_rays, end_to_end);
+criterion_main!(benches);
