@@ -4,7 +4,9 @@
 //! at face value; and every rejection names the file, line and column, what was found and what
 //! would be valid, because a case file is edited by hand.
 
+mod assignment;
 mod error;
+mod export;
 mod objects;
 mod sections;
 mod spec;
@@ -17,7 +19,9 @@ use std::path::Path;
 
 use toml::de::DeTable;
 
+pub use assignment::{AssignmentOptions, load_assignment_scene, parse_assignment_scene};
 pub use error::{CaseError, SourceLocation};
+pub use export::case_to_toml;
 pub use sections::{MAX_BOUNCES, MAX_IMAGE_SIZE};
 pub use spec::{
     BackgroundSpec, CameraSpec, Case, LightSpec, MaterialSpec, ObjectSpec, RenderSettings,

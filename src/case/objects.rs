@@ -1,7 +1,7 @@
 //! `[[object]]` tables: shapes, material references, transforms, and groups nested to any depth.
 
 use std::io::ErrorKind;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use glam::{DMat3, DVec4};
 
@@ -121,18 +121,24 @@ fn triple(f: &Field, read: fn(&Field) -> Result<[f64; 3]>) -> Result<[[f64; 3]; 
 /// parsing the OBJ is the scene builder's job.
 fn obj_path(f: &Field) -> Result<PathBuf> {
     let path = f.doc.dir.join(f.string()?);
-    let (shown, written) = (path.display(), f.excerpt());
-    match std::fs::metadata(&path) {
-        Ok(meta) if meta.is_file() => Ok(path),
-        Ok(_) => Err(f.error(format!(
-            "obj = {written} resolves to {shown}, which is not a file"
+    match file_problem(&path) {
+        None => Ok(path),
+        Some(problem) => Err(f.error(format!(
+            "obj = {} resolves to {}, {problem}",
+            f.excerpt(),
+            path.display()
         ))),
-        Err(e) if e.kind() == ErrorKind::NotFound => Err(f.error(format!(
-            "obj = {written} resolves to {shown}, which does not exist"
-        ))),
-        Err(e) => Err(f.error(format!(
-            "obj = {written} resolves to {shown}, which cannot be read: {e}"
-        ))),
+    }
+}
+
+/// Why `path` cannot serve as an OBJ file, phrased to follow "resolves to PATH, ". Shared with
+/// the assignment importer so that both formats accept the same files.
+pub(crate) fn file_problem(path: &Path) -> Option<String> {
+    match std::fs::metadata(path) {
+        Ok(meta) if meta.is_file() => None,
+        Ok(_) => Some("which is not a file".to_owned()),
+        Err(e) if e.kind() == ErrorKind::NotFound => Some("which does not exist".to_owned()),
+        Err(e) => Some(format!("which cannot be read: {e}")),
     }
 }
 
@@ -184,22 +190,24 @@ fn rotate(f: &Field) -> Result<TransformOp> {
     })
 }
 
-/// Rays are intersected in object space through the inverse and normals come back through its
-/// transpose, so a transform must be comfortably invertible. `DMat4::inverse` never fails (it
-/// returns infinities or NaN), hence the explicit checks.
 fn check_invertible(f: &Field, ops: &[TransformOp]) -> Result<()> {
-    let m = composite_matrix(ops);
-    let error = |problem: String| {
-        let written = f.excerpt();
-        f.doc.error_at(
+    match singularity(ops) {
+        None => Ok(()),
+        Some(problem) => Err(f.doc.error_at(
             &f.key_span,
-            format!("{} {problem}; found {written}", f.name),
-        )
-    };
+            format!("{} {problem}; found {}", f.name, f.excerpt()),
+        )),
+    }
+}
+
+/// Why the composite of `ops` is not comfortably invertible, if it is not. Rays are intersected
+/// in object space through the inverse and normals come back through its transpose.
+/// `DMat4::inverse` never fails (it returns infinities or NaN), hence the explicit checks.
+/// Shared with the assignment importer so that both formats accept the same transforms.
+pub(crate) fn singularity(ops: &[TransformOp]) -> Option<String> {
+    let m = composite_matrix(ops);
     if !m.is_finite() {
-        return Err(error(
-            "overflows: the composite matrix has non-finite entries".to_owned(),
-        ));
+        return Some("overflows: the composite matrix has non-finite entries".to_owned());
     }
     // Translation does not affect invertibility but would dominate the scale of an affine
     // matrix, so only its linear part is judged; a projective `matrix` is judged whole.
@@ -222,11 +230,10 @@ fn check_invertible(f: &Field, ops: &[TransformOp]) -> Result<()> {
         (m.determinant(), scale, (m * scale.recip()).determinant())
     };
     let invertible = relative.abs() > SINGULAR && m.inverse().is_finite();
-    if !invertible {
-        return Err(error(format!(
+    (!invertible).then(|| {
+        format!(
             "is singular (determinant {determinant:.3e} for entries up to {scale:.3e}), which \
              flattens the object: check for a zero scale or a degenerate matrix"
-        )));
-    }
-    Ok(())
+        )
+    })
 }

@@ -1,6 +1,8 @@
 //! The scene-wide sections: `[render]`, `[tolerance]`, `[camera]`, `[background]`, `[[light]]`
 //! and `[materials.NAME]`.
 
+use std::path::Path;
+
 use glam::DVec3;
 
 use super::error::CaseError;
@@ -155,12 +157,7 @@ pub(crate) fn camera(doc: &Doc, field: Option<Field>) -> Result<CameraSpec> {
     let direction = direction_field.direction()?;
     let up_field = t.require("up")?;
     let up = up_field.direction()?;
-    // The camera basis is cross(direction, up); parallel vectors leave it undefined.
-    let sine = DVec3::from(direction)
-        .normalize()
-        .cross(DVec3::from(up).normalize())
-        .length();
-    if sine < 1e-9 {
+    if is_parallel(direction, up) {
         let d = direction_field.excerpt();
         return Err(up_field.invalid(format!("must not be parallel to direction {d}")));
     }
@@ -177,6 +174,16 @@ pub(crate) fn camera(doc: &Doc, field: Option<Field>) -> Result<CameraSpec> {
     })
 }
 
+/// The camera basis is cross(direction, up); parallel vectors leave it undefined. Shared with the
+/// assignment importer so that both formats accept the same cameras.
+pub(crate) fn is_parallel(direction: [f64; 3], up: [f64; 3]) -> bool {
+    let sine = DVec3::from(direction)
+        .normalize()
+        .cross(DVec3::from(up).normalize())
+        .length();
+    sine < 1e-9
+}
+
 pub(crate) fn background<'a>(
     doc: &'a Doc<'a>,
     field: Option<Field<'a, '_>>,
@@ -190,23 +197,9 @@ pub(crate) fn background<'a>(
             );
         }
         let path = doc.dir.join(f.string()?);
-        if !path.is_dir() {
-            let shown = path.display();
-            return Err(f.invalid(format!("must name a directory, but {shown} is not one")));
-        }
-        match CUBE_FACES
-            .iter()
-            .map(|face| path.join(format!("{face}.png")))
-            .find(|p| !p.is_file())
-        {
-            Some(missing) => {
-                let shown = missing.display();
-                Err(f.invalid(format!(
-                    "must hold the six faces {}.png; {shown} is missing",
-                    CUBE_FACES.join("/")
-                )))
-            }
+        match cube_map_problem(&path) {
             None => Ok(Some(path)),
+            Some(problem) => Err(f.invalid(problem)),
         }
     })?;
     Ok(BackgroundSpec {
@@ -214,6 +207,24 @@ pub(crate) fn background<'a>(
         ambient: t.read("ambient", [0.0; 3], Field::color)?,
         cube_map,
     })
+}
+
+/// What a cube-map directory lacks, phrased as a requirement ("must …"), if anything. Shared
+/// with the assignment importer so that both formats accept the same cube maps.
+pub(crate) fn cube_map_problem(path: &Path) -> Option<String> {
+    let shown = path.display();
+    if !path.is_dir() {
+        return Some(format!("must name a directory, but {shown} is not one"));
+    }
+    let missing = CUBE_FACES
+        .iter()
+        .map(|face| path.join(format!("{face}.png")))
+        .find(|p| !p.is_file())?;
+    Some(format!(
+        "must hold the six faces {}.png; {} is missing",
+        CUBE_FACES.join("/"),
+        missing.display()
+    ))
 }
 
 #[derive(Clone, Copy)]

@@ -332,8 +332,7 @@ impl<'a, 'i> Field<'a, 'i> {
     /// A vector that will be normalised downstream, so its length must survive `1/length`.
     pub fn direction(&self) -> Result<[f64; 3]> {
         let v = self.vec3()?;
-        let length = glam::DVec3::from(v).length();
-        if length > 0.0 && length.is_finite() && (1.0 / length).is_finite() {
+        if has_usable_length(v) {
             Ok(v)
         } else {
             Err(self.invalid("must have a nonzero, finite length"))
@@ -349,6 +348,13 @@ impl<'a, 'i> Field<'a, 'i> {
             self.error(format!("unknown {} `{written}`{tail}", self.name))
         })
     }
+}
+
+/// Whether `v` survives normalisation (`1/length` finite). Shared with the assignment importer so
+/// that both formats accept the same directions.
+pub(crate) fn has_usable_length(v: [f64; 3]) -> bool {
+    let length = glam::DVec3::from(v).length();
+    length > 0.0 && length.is_finite() && (1.0 / length).is_finite()
 }
 
 /// Captures the variant list that serde's derive hands to `unknown_variant`.
