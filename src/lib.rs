@@ -2,6 +2,7 @@
 //!
 //! Data flows one way: case → scene → render → film → outputs → compare.
 
+pub mod assignment_outputs;
 pub mod case;
 pub mod error;
 pub mod film;

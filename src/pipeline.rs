@@ -2,7 +2,8 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::case::{self, Case, LoadOptions};
+use crate::assignment_outputs::AssignmentOutputs;
+use crate::case::{self, AssignmentOptions, Case, LoadOptions, case_to_toml, load_assignment_scene};
 use crate::error::Error;
 use crate::film::{Film, OutputOptions, write_outputs};
 use crate::render::{Progress, RenderOptions, render};
@@ -45,4 +46,24 @@ pub fn render_case_file(
     let case = case::load(path, load)?;
     let film = render_case(&case, show_progress)?;
     Ok(write_outputs(out_dir, &case.name, &film, &output_options(&case))?)
+}
+
+/// `goldray mit6837`: renders a course scene file as the course binary would and writes the
+/// files its flags name.
+pub fn render_assignment(
+    scene: &Path,
+    options: &AssignmentOptions,
+    outputs: &AssignmentOutputs,
+    show_progress: bool,
+) -> Result<Vec<PathBuf>, Error> {
+    let case = load_assignment_scene(scene, options)?;
+    let film = render_case(&case, show_progress)?;
+    Ok(outputs.write(&film)?)
+}
+
+/// `goldray import`: the TOML case equivalent to a course scene file, with asset paths
+/// relative to where the TOML will live.
+pub fn import_assignment(scene: &Path, options: &AssignmentOptions, toml_path: &Path) -> Result<String, Error> {
+    let case = load_assignment_scene(scene, options)?;
+    Ok(case_to_toml(&case, toml_path))
 }

@@ -49,7 +49,7 @@ fn depth_and_normal_images_are_written_when_the_case_asks() {
 
 #[test]
 fn exr_is_bit_identical_with_one_and_two_threads() {
-    for name in ["jitter_filter.toml", "mirrors.toml", "nested_groups.toml"] {
+    for name in ["jitter_filter.toml", "mirrors.toml", "nested_groups.toml", "blob_mesh.toml"] {
         let mut bytes = Vec::new();
         for threads in ["1", "2"] {
             let out = tempfile::tempdir().unwrap();
@@ -115,4 +115,22 @@ fn missing_case_file_and_zero_threads_are_errors() {
     let zero = goldray(&["render", case("jitter.toml").to_str().unwrap(), "--threads", "0"]);
     assert!(!zero.status.success());
     assert!(stderr(&zero).contains("threads"), "{}", stderr(&zero));
+}
+
+#[test]
+fn an_unreadable_cube_map_face_is_an_error_naming_the_face() {
+    let dir = tempfile::tempdir().unwrap();
+    let faces = dir.path().join("sky");
+    fs::create_dir(&faces).unwrap();
+    for face in ["left", "right", "up", "down", "front", "back"] {
+        fs::write(faces.join(format!("{face}.png")), b"not a png").unwrap();
+    }
+    let case_path = dir.path().join("sky.toml");
+    fs::write(&case_path, "[camera]\ncenter = [0, 0, 10]\ndirection = [0, 0, -1]\nup = [0, 1, 0]\nfov = 30\n\n[background]\ncube_map = \"sky\"\n").unwrap();
+    let out = dir.path().join("out");
+    let result = goldray(&["render", case_path.to_str().unwrap(), "--out", out.to_str().unwrap()]);
+    assert_eq!(result.status.code(), Some(1));
+    let message = stderr(&result);
+    assert!(message.contains("sky.toml") && message.contains(".png"), "{message}");
+    assert!(files_in(&out).is_empty());
 }

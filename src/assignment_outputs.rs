@@ -1,0 +1,41 @@
+//! The course binary's outputs: a colour PNG at an exact path, and optional normals and depth
+//! PNGs at their own paths, plus goldray's linear EXR when asked.
+
+use std::path::{Path, PathBuf};
+
+use crate::film::{Film, OutputError, Tonemap, color_image, depth_image, encode_exr, encode_png, normals_image, write_file_atomic};
+
+/// Where `goldray mit6837` writes, mirroring the course binary's `-output`, `-normals` and
+/// `-depth min max file` flags.
+#[derive(Clone, Debug, Default)]
+pub struct AssignmentOutputs {
+    pub color: Option<PathBuf>,
+    pub normals: Option<PathBuf>,
+    pub depth: Option<(f32, f32, PathBuf)>,
+    pub exr: Option<PathBuf>,
+}
+
+impl AssignmentOutputs {
+    /// Encodes every file before writing any, so a film that cannot be encoded writes nothing;
+    /// each file is then replaced atomically.
+    pub fn write(&self, film: &Film) -> Result<Vec<PathBuf>, OutputError> {
+        let tonemap = Tonemap::Clamp;
+        let mut files: Vec<(&Path, Vec<u8>)> = Vec::new();
+        if let Some(path) = &self.color {
+            files.push((path, encode_png(&color_image(film, tonemap))?));
+        }
+        if let Some(path) = &self.normals {
+            files.push((path, encode_png(&normals_image(film, tonemap))?));
+        }
+        if let Some((min, max, path)) = &self.depth {
+            files.push((path, encode_png(&depth_image(film, *min, *max, tonemap))?));
+        }
+        if let Some(path) = &self.exr {
+            files.push((path, encode_exr(film)?));
+        }
+        for (path, bytes) in &files {
+            write_file_atomic(path, bytes)?;
+        }
+        Ok(files.into_iter().map(|(path, _)| path.to_path_buf()).collect())
+    }
+}
