@@ -3,12 +3,15 @@
 //! - `primary_rays/blob_1.3M`: camera rays into a 1,310,720-triangle mesh that fills the frame,
 //!   on one thread (per-core figure) and on all cores; criterion reports rays/s as elements/s.
 //! - `end_to_end/*`: load, build and render shipped cases (no file writes).
+//! - `course_scenes/seven_at_800`: the course's seven grading commands at 800×800, one after
+//!   another, each parsed, rendered and its three PNGs encoded, as `goldray mit6837` does.
 
 use std::path::Path;
 use std::sync::Arc;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use goldray::case::{LoadOptions, load};
+use goldray::case::{AssignmentOptions, LoadOptions, load, load_assignment_scene};
+use goldray::film::{Tonemap, color_image, depth_image, encode_png, normals_image};
 use goldray::geometry::generate::blob;
 use goldray::geometry::mesh::{Mesh, VertexNormals};
 use goldray::pipeline::render_case;
@@ -72,5 +75,49 @@ fn end_to_end(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, primary_rays, end_to_end);
+/// (scene, depth range, bounces, shadows) of the course's grading commands.
+const COURSE_COMMANDS: [(&str, (f64, f64), u32, bool); 7] = [
+    ("scene01_plane", (8.0, 18.0), 0, false),
+    ("scene02_cube", (8.0, 18.0), 0, false),
+    ("scene03_sphere", (8.0, 18.0), 0, false),
+    ("scene04_axes", (8.0, 18.0), 0, false),
+    ("scene05_bunny_200", (0.8, 1.0), 0, false),
+    ("scene06_bunny_1k", (8.0, 18.0), 4, false),
+    ("scene07_arch", (8.0, 18.0), 4, true),
+];
+
+fn course_scenes(c: &mut Criterion) {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/mit6837/data");
+    assert!(data.is_dir(), "../shared/mit6837 is missing: the course benchmark needs its scenes");
+    let mut group = c.benchmark_group("course_scenes");
+    group.sample_size(10);
+    group.bench_function("seven_at_800", |b| {
+        b.iter(|| {
+            for (scene, depth_range, bounces, shadows) in COURSE_COMMANDS {
+                let options = AssignmentOptions {
+                    width: 800,
+                    height: 800,
+                    bounces,
+                    shadows,
+                    depth_range: Some(depth_range),
+                    normals: true,
+                    ..AssignmentOptions::default()
+                };
+                let case = load_assignment_scene(&data.join(format!("{scene}.txt")), &options).expect("a course scene loads");
+                let film = render_case(&case, false).expect("a course scene renders");
+                let (min, max) = (depth_range.0 as f32, depth_range.1 as f32);
+                for image in [
+                    color_image(&film, Tonemap::Clamp),
+                    normals_image(&film, Tonemap::Clamp),
+                    depth_image(&film, min, max, Tonemap::Clamp),
+                ] {
+                    encode_png(&image).expect("PNG encoding");
+                }
+            }
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, primary_rays, end_to_end, course_scenes);
 criterion_main!(benches);
