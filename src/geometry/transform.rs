@@ -57,11 +57,23 @@ impl Transform {
         &self.object_to_world
     }
 
-    pub fn ray_to_object(&self, ray: &Ray) -> Ray {
-        Ray::new(
-            self.world_to_object.transform_point3(ray.origin),
-            self.world_to_object.transform_vector3(ray.direction),
-        )
+    /// The ray in object space, and how far along it (in the ray's parameter) its origin was
+    /// pushed. Transforming the origin rounds it by up to `gamma(3)·(|M⁻¹|·|o| + |t|)`, which
+    /// can carry a spawned origin back through the surface it just left; like pbrt-v4, the
+    /// origin is moved forward along the direction past that error, and callers add the shift
+    /// back so that `t` stays the world ray's parameter.
+    pub fn ray_to_object(&self, ray: &Ray) -> (Ray, Real) {
+        let origin = self.world_to_object.transform_point3(ray.origin);
+        let direction = self.world_to_object.transform_vector3(ray.direction);
+        let length_squared = direction.length_squared();
+        if length_squared == 0.0 {
+            return (Ray::new(origin, direction), 0.0);
+        }
+        let abs_linear = Mat3::from_mat4(self.world_to_object).abs();
+        let translation = self.world_to_object.w_axis.truncate().abs();
+        let origin_error = gamma(3) * (abs_linear * ray.origin.abs() + translation);
+        let shift = direction.abs().dot(origin_error) / length_squared;
+        (Ray::new(origin + direction * shift, direction), shift)
     }
 
     pub fn point_to_world(&self, point: Vec3) -> Vec3 {
@@ -79,17 +91,24 @@ impl Transform {
     }
 
     /// The error bound follows pbrt-v4's `Transform::operator()(Point3fi)`: the rounding of the
-    /// matrix product itself, plus the incoming error carried through `|M|`.
+    /// matrix product itself, plus the incoming error carried through `|M|`. It also covers the
+    /// way back: a ray spawned here is transformed to object space again, which rounds its
+    /// origin by up to `gamma(3)·(|M⁻¹|·|p| + |t⁻¹|)`; mapped to world space by `|M|`, that is
+    /// added too, so the spawn offset along the normal always exceeds it (far from the origin
+    /// or under anisotropic scale, the return trip alone can otherwise re-hit the surface).
     pub fn hit_to_world(&self, hit: &SurfaceHit) -> SurfaceHit {
         let point = self.point_to_world(hit.point);
         let abs_linear = Mat3::from_mat4(self.object_to_world).abs();
         let translation = self.object_to_world.w_axis.truncate().abs();
-        let point_error = gamma(3) * (abs_linear * hit.point.abs() + translation)
+        let abs_inverse_linear = Mat3::from_mat4(self.world_to_object).abs();
+        let inverse_translation = self.world_to_object.w_axis.truncate().abs();
+        let forward_error = gamma(3) * (abs_linear * hit.point.abs() + translation)
             + (1.0 + gamma(3)) * (abs_linear * hit.point_error);
+        let return_error = gamma(3) * (abs_inverse_linear * point.abs() + inverse_translation);
         SurfaceHit {
             t: hit.t,
             point,
-            point_error,
+            point_error: forward_error + (1.0 + gamma(3)) * (abs_linear * return_error),
             geometric_normal: self.normal_to_world(hit.geometric_normal),
             shading_normal: self.normal_to_world(hit.shading_normal),
         }
@@ -144,9 +163,10 @@ mod tests {
         )
         .unwrap();
         let ray = Ray::new(Vec3::new(-5.0, 1.0, 2.0), Vec3::new(1.0, 0.25, 0.1));
-        let local = transform.ray_to_object(&ray);
+        let (local, shift) = transform.ray_to_object(&ray);
+        assert!(shift > 0.0 && shift < 1e-5, "the origin moves by its rounding error only: {shift}");
         let t = 3.0;
-        let back = transform.point_to_world(local.at(t));
+        let back = transform.point_to_world(local.at(t - shift));
         assert!((back - ray.at(t)).length() < 1e-5);
     }
 }

@@ -49,6 +49,17 @@ impl ShapeHit {
             ShapeHit::Mesh(hit) => hit.t,
         }
     }
+
+    /// The same hit with its ray parameter moved by `shift`: between the parameter of an
+    /// instance's object-space ray and that of the world ray it came from.
+    fn shifted(mut self, shift: Real) -> ShapeHit {
+        match &mut self {
+            ShapeHit::Sphere(t) => *t += shift,
+            ShapeHit::Triangle(hit) => hit.t += shift,
+            ShapeHit::Mesh(hit) => hit.t += shift,
+        }
+        self
+    }
 }
 
 impl Object {
@@ -64,54 +75,54 @@ impl Object {
         }
     }
 
-    pub fn intersect(&self, world_ray: &Ray, t_max: Real) -> Option<ShapeHit> {
-        let local;
-        let ray = match &self.transform {
-            Some(transform) => {
-                local = transform.ray_to_object(world_ray);
-                &local
-            }
-            None => world_ray,
-        };
-        match &self.shape {
-            Shape::Sphere(sphere) => sphere.intersect(ray, t_max).map(ShapeHit::Sphere),
-            Shape::Triangle(triangle) => {
-                let [p0, p1, p2] = triangle.vertices;
-                intersect_triangle(&TriangleRay::new(ray), t_max, p0, p1, p2).map(ShapeHit::Triangle)
-            }
-            Shape::Mesh(mesh) => mesh.intersect(ray, t_max).map(ShapeHit::Mesh),
+    /// The ray in the shape's own space and the shift of its parameter (see
+    /// `Transform::ray_to_object`).
+    fn local_ray(&self, world_ray: &Ray) -> (Ray, Real) {
+        match &self.transform {
+            Some(transform) => transform.ray_to_object(world_ray),
+            None => (*world_ray, 0.0),
         }
     }
 
+    /// The closest hit before `t_max`, with `t` in the world ray's parameter.
+    pub fn intersect(&self, world_ray: &Ray, t_max: Real) -> Option<ShapeHit> {
+        let (ray, shift) = self.local_ray(world_ray);
+        let t_max = t_max - shift;
+        let hit = match &self.shape {
+            Shape::Sphere(sphere) => sphere.intersect(&ray, t_max).map(ShapeHit::Sphere),
+            Shape::Triangle(triangle) => {
+                let [p0, p1, p2] = triangle.vertices;
+                intersect_triangle(&TriangleRay::new(&ray), t_max, p0, p1, p2).map(ShapeHit::Triangle)
+            }
+            Shape::Mesh(mesh) => mesh.intersect(&ray, t_max).map(ShapeHit::Mesh),
+        }?;
+        Some(hit.shifted(shift))
+    }
+
     pub fn occluded(&self, world_ray: &Ray, t_max: Real) -> bool {
-        match (&self.shape, &self.transform) {
-            (Shape::Mesh(mesh), Some(transform)) => mesh.occluded(&transform.ray_to_object(world_ray), t_max),
-            (Shape::Mesh(mesh), None) => mesh.occluded(world_ray, t_max),
+        match &self.shape {
+            Shape::Mesh(mesh) => {
+                let (ray, shift) = self.local_ray(world_ray);
+                mesh.occluded(&ray, t_max - shift)
+            }
             _ => self.intersect(world_ray, t_max).is_some(),
         }
     }
 
     /// The full hit record in world space.
     pub fn surface(&self, world_ray: &Ray, hit: &ShapeHit) -> SurfaceHit {
-        let local;
-        let ray = match &self.transform {
-            Some(transform) => {
-                local = transform.ray_to_object(world_ray);
-                &local
-            }
-            None => world_ray,
-        };
-        let surface = match (&self.shape, hit) {
-            (Shape::Sphere(sphere), ShapeHit::Sphere(t)) => sphere.surface(ray, *t),
+        let (ray, shift) = self.local_ray(world_ray);
+        let surface = match (&self.shape, hit.shifted(-shift)) {
+            (Shape::Sphere(sphere), ShapeHit::Sphere(t)) => sphere.surface(&ray, t),
             (Shape::Triangle(triangle), ShapeHit::Triangle(hit)) => {
                 let [p0, p1, p2] = triangle.vertices;
-                triangle_surface(p0, p1, p2, triangle.normals, hit)
+                triangle_surface(p0, p1, p2, triangle.normals, &hit)
             }
-            (Shape::Mesh(mesh), ShapeHit::Mesh(hit)) => mesh.surface(hit),
+            (Shape::Mesh(mesh), ShapeHit::Mesh(hit)) => mesh.surface(&hit),
             _ => unreachable!("a ShapeHit always comes from the same object's intersect"),
         };
         match &self.transform {
-            Some(transform) => transform.hit_to_world(&surface),
+            Some(transform) => SurfaceHit { t: hit.t(), ..transform.hit_to_world(&surface) },
             None => surface,
         }
     }
