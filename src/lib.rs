@@ -3,6 +3,7 @@
 //! Data flows one way: case → scene → render → film → outputs → compare.
 
 pub mod case;
+pub mod compare;
 pub mod error;
 pub mod film;
 pub mod geometry;

@@ -34,6 +34,9 @@ enum Command {
         #[arg(long)]
         force: bool,
     },
+    /// Compare two EXR or PNG images within a tolerance. Exit code: 0 pass, 1 warn (some pixels
+    /// over --pixel, every limit kept), 2 fail, 3 size or channel mismatch, 4 unreadable file.
+    Diff(goldray::compare::DiffArgs),
 }
 
 fn main() -> ExitCode {
@@ -59,6 +62,7 @@ fn run(cli: Cli) -> Result<(), String> {
             }
             Ok(())
         }
+        Command::Diff(args) => std::process::exit(i32::from(goldray::compare::run_diff(&args))),
     }
 }
 
