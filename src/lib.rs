@@ -4,6 +4,7 @@
 
 pub mod assignment_outputs;
 pub mod case;
+pub mod compare;
 pub mod error;
 pub mod film;
 pub mod geometry;

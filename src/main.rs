@@ -73,6 +73,9 @@ enum Command {
         #[command(flatten)]
         course: CourseFlags,
     },
+    /// Compare two EXR or PNG images within a tolerance. Exit code: 0 pass, 1 warn (some pixels
+    /// over --pixel, every limit kept), 2 fail, 3 size or channel mismatch, 4 unreadable file.
+    Diff(goldray::compare::DiffArgs),
 }
 
 /// The course binary's rendering flags, shared by `mit6837` and `import` so that an imported
@@ -111,7 +114,7 @@ struct RunFlags {
 
 fn main() -> ExitCode {
     match run(Cli::parse_from(course_style_flags(std::env::args_os()))) {
-        Ok(()) => ExitCode::SUCCESS,
+        Ok(code) => code,
         Err(message) => {
             eprintln!("error: {message}");
             ExitCode::FAILURE
@@ -143,13 +146,14 @@ fn course_style_flags(args: impl Iterator<Item = OsString>) -> Vec<OsString> {
         .collect()
 }
 
-fn run(cli: Cli) -> Result<(), String> {
+/// The exit code on success: 0, except `diff`, whose code is its verdict.
+fn run(cli: Cli) -> Result<ExitCode, String> {
     match cli.command {
         Command::Render { case, out, run } => {
             let load = LoadOptions { allow_huge_images: run.force };
             let written = run.install(|| render_case_file(&case, &out, &load, !run.quiet))?;
             run.report(&written);
-            Ok(())
+            Ok(ExitCode::SUCCESS)
         }
         Command::Mit6837 { input, output, normals, depth, exr, course, run } => {
             let depth = depth.map(|values| parse_depth(&values[..2]).map(|(min, max)| (min, max, PathBuf::from(&values[2])))).transpose()?;
@@ -166,7 +170,7 @@ fn run(cli: Cli) -> Result<(), String> {
             let options = course.options(depth_range, outputs.normals.is_some(), run.force)?;
             let written = run.install(|| render_assignment(&input, &options, &outputs, !run.quiet))?;
             run.report(&written);
-            Ok(())
+            Ok(ExitCode::SUCCESS)
         }
         Command::Import { scene, output, force, depth, normals, course } => {
             let depth_range = depth.map(|values| parse_depth(&values)).transpose()?;
@@ -180,7 +184,9 @@ fn run(cli: Cli) -> Result<(), String> {
                 Some(path) => goldray::film::write_file_atomic(&path, text.as_bytes()).map_err(|e| e.to_string()),
                 None => std::io::stdout().write_all(text.as_bytes()).map_err(|e| format!("cannot write to standard output: {e}")),
             }
+            .map(|()| ExitCode::SUCCESS)
         }
+        Command::Diff(args) => Ok(ExitCode::from(goldray::compare::run_diff(&args))),
     }
 }
 

@@ -1,0 +1,213 @@
+//! One comparison from start to finish, and the report a person reads (or a script parses).
+
+use std::fmt;
+use std::path::PathBuf;
+
+use serde::Serialize;
+
+use super::image::{COLOR_CHANNELS, Encoding, Image};
+use super::metrics::{Metrics, measure, same_layout};
+use super::verdict::{Layout, Verdict, judge, percent};
+use crate::case::Tolerance;
+
+/// The outcome of comparing `actual` against `expected`. `metrics` is `None` only for a
+/// [`Verdict::Mismatch`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Comparison {
+    pub expected: PathBuf,
+    pub actual: PathBuf,
+    pub tolerance: Tolerance,
+    pub metrics: Option<Metrics>,
+    pub verdict: Verdict,
+    /// Where the caller wrote the diff heatmap, for the report to point at.
+    pub diff_image: Option<PathBuf>,
+}
+
+/// Compares `actual` against `expected` under `tolerance`, in the images' own units.
+///
+/// A NaN limit counts as 0, the strictest: every comparison with NaN is false, so taken as given
+/// it would let any difference through.
+pub fn compare(expected: &Image, actual: &Image, tolerance: &Tolerance) -> Comparison {
+    let strict = |limit: f64| if limit.is_nan() { 0.0 } else { limit };
+    let tolerance = &Tolerance {
+        pixel: strict(tolerance.pixel),
+        fail_fraction: strict(tolerance.fail_fraction),
+        rmse: strict(tolerance.rmse),
+        max: tolerance.max.map(strict),
+    };
+    let (metrics, verdict) = if same_layout(expected, actual) {
+        let metrics = measure(expected, actual, tolerance.pixel);
+        let verdict = judge(&metrics, tolerance);
+        (Some(metrics), verdict)
+    } else {
+        let verdict = Verdict::Mismatch {
+            expected: Layout::of(expected),
+            actual: Layout::of(actual),
+        };
+        (None, verdict)
+    };
+    Comparison {
+        expected: expected.source.clone(),
+        actual: actual.source.clone(),
+        tolerance: tolerance.clone(),
+        metrics,
+        verdict,
+        diff_image: None,
+    }
+}
+
+#[derive(Serialize)]
+struct JsonTolerance {
+    pixel: f64,
+    fail_fraction: f64,
+    rmse: f64,
+    max: Option<f64>,
+}
+
+#[derive(Serialize)]
+struct JsonReport<'a> {
+    #[serde(flatten)]
+    verdict: &'a Verdict,
+    exit_code: u8,
+    expected: &'a PathBuf,
+    actual: &'a PathBuf,
+    tolerance: JsonTolerance,
+    metrics: &'a Option<Metrics>,
+    diff_image: &'a Option<PathBuf>,
+}
+
+impl Comparison {
+    /// The report as pretty-printed JSON, the verdict first. Infinite and NaN numbers (the PSNR
+    /// of identical images, a NaN pixel value) become `null`, as JSON has no such numbers.
+    pub fn to_json(&self) -> String {
+        let t = &self.tolerance;
+        let report = JsonReport {
+            expected: &self.expected,
+            actual: &self.actual,
+            verdict: &self.verdict,
+            exit_code: self.verdict.exit_code(),
+            tolerance: JsonTolerance {
+                pixel: t.pixel,
+                fail_fraction: t.fail_fraction,
+                rmse: t.rmse,
+                max: t.max,
+            },
+            metrics: &self.metrics,
+            diff_image: &self.diff_image,
+        };
+        serde_json::to_string_pretty(&report)
+            .unwrap_or_else(|e| serde_json::json!({ "error": e.to_string() }).to_string())
+    }
+}
+
+impl fmt::Display for Comparison {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(
+            f,
+            "{}: {} against {}",
+            self.verdict.word(),
+            self.actual.display(),
+            self.expected.display()
+        )?;
+        match &self.verdict {
+            Verdict::Mismatch { expected, actual } => {
+                writeln!(f, "  cannot compare: {}", mismatch(expected, actual))?;
+            }
+            Verdict::Fail { breaches } => {
+                for breach in breaches {
+                    writeln!(f, "  broke {breach}")?;
+                }
+            }
+            Verdict::Pass | Verdict::Warn => {}
+        }
+        if let Some(metrics) = &self.metrics {
+            write_metrics(f, metrics)?;
+        }
+        if let Some(path) = &self.diff_image {
+            writeln!(
+                f,
+                "  diff heatmap: {} (magenta = failing pixel, cyan = NaN/inf)",
+                path.display()
+            )?;
+        }
+        Ok(())
+    }
+}
+
+fn write_metrics(f: &mut fmt::Formatter<'_>, m: &Metrics) -> fmt::Result {
+    let units = match m.encoding {
+        Encoding::Linear => "linear",
+        Encoding::Code8 => "8-bit codes",
+    };
+    writeln!(
+        f,
+        "  failing pixels: {} of {} ({}) differ by more than {} ({units})",
+        m.failing_pixels,
+        m.pixels,
+        percent(m.failing_fraction),
+        m.pixel_threshold
+    )?;
+    match &m.worst {
+        Some(worst) => writeln!(f, "  worst colour: {worst} (|diff| {:.6})", worst.error())?,
+        None => writeln!(f, "  worst colour: none, colour is identical")?,
+    }
+    for channel in m
+        .channels
+        .iter()
+        .filter(|c| c.failing > 0 && !COLOR_CHANNELS.contains(&c.name))
+    {
+        if let Some(worst) = &channel.worst {
+            writeln!(
+                f,
+                "  {} fails on {} pixels, worst {worst}",
+                channel.name, channel.failing
+            )?;
+        }
+    }
+    writeln!(
+        f,
+        "  colour: MAE {:.6}  RMSE {:.6}  PSNR {}  FLIP {:.5}",
+        m.mae,
+        m.rmse,
+        if m.psnr.is_finite() {
+            format!("{:.2} dB", m.psnr)
+        } else {
+            "inf".to_owned()
+        },
+        m.flip
+    )
+}
+
+fn mismatch(expected: &Layout, actual: &Layout) -> String {
+    let describe = |l: &Layout| {
+        let kind = match l.encoding {
+            Encoding::Linear => "EXR",
+            Encoding::Code8 => "8-bit",
+        };
+        format!(
+            "{}x{} {kind} with channels {}",
+            l.width,
+            l.height,
+            l.channels.join(" ")
+        )
+    };
+    let mut differences = Vec::new();
+    if (expected.width, expected.height) != (actual.width, actual.height) {
+        differences.push("size");
+    }
+    if expected.encoding != actual.encoding {
+        differences.push("encoding");
+    }
+    if expected.channels != actual.channels {
+        differences.push("channels");
+    }
+    if differences.is_empty() {
+        differences.push("buffer lengths");
+    }
+    format!(
+        "{} differ: expected {}, actual {}",
+        differences.join(" and "),
+        describe(expected),
+        describe(actual)
+    )
+}

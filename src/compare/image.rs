@@ -1,0 +1,181 @@
+//! What a comparison reads: an EXR film or an 8-bit PNG, as named channel planes plus the 8-bit
+//! sRGB picture that FLIP and the diff heatmap need.
+
+use std::path::{Path, PathBuf};
+
+use ::exr::meta::MetaData;
+use image::RgbImage;
+use serde::Serialize;
+
+use super::error::CompareError;
+use crate::film::{Film, Tonemap, color_image, decode_exr};
+
+/// The EXR channels goldray writes and reads, in the contract's order. Other channels in a file
+/// are not compared, because the film reader does not decode them.
+const FILM_CHANNELS: [&str; 7] = ["R", "G", "B", "Z", "N.X", "N.Y", "N.Z"];
+
+/// The colour channels: the ones MAE, RMSE, PSNR and the worst pixel are measured on.
+pub const COLOR_CHANNELS: [&str; 3] = ["R", "G", "B"];
+
+const EXR_MAGIC: [u8; 4] = [0x76, 0x2f, 0x31, 0x01];
+const PNG_MAGIC: [u8; 8] = [0x89, b'P', b'N', b'G', b'\r', b'\n', 0x1a, b'\n'];
+
+/// How the values of an image are encoded, which sets the units of every threshold and metric.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Encoding {
+    /// Scene-referred linear floats (EXR); PSNR is measured against a peak of 1.
+    Linear,
+    /// Display-referred 8-bit code values 0–255 (PNG); PSNR is measured against a peak of 255.
+    Code8,
+}
+
+impl Encoding {
+    pub fn peak(self) -> f64 {
+        match self {
+            Encoding::Linear => 1.0,
+            Encoding::Code8 => 255.0,
+        }
+    }
+}
+
+/// One channel's values, row-major with row 0 at the top.
+#[derive(Clone, Debug)]
+pub struct Channel {
+    pub name: &'static str,
+    pub values: Vec<f32>,
+}
+
+impl Channel {
+    /// Depth stores a miss as `+inf`, so there `+inf` against a finite depth is a silhouette that
+    /// moved (a failing pixel), not a broken value.
+    pub fn infinity_is_a_value(&self) -> bool {
+        self.name == "Z"
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct Image {
+    /// The file (or snapshot) the image came from, for messages.
+    pub source: PathBuf,
+    pub encoding: Encoding,
+    pub width: u32,
+    pub height: u32,
+    pub channels: Vec<Channel>,
+    /// The colour as a person sees it: FLIP's input and the heatmap's backdrop.
+    pub preview: RgbImage,
+}
+
+impl Image {
+    /// All seven film channels; colour is previewed with the sRGB tone map whatever the case's
+    /// own tone map, because FLIP models a viewer looking at an sRGB display.
+    pub fn from_film(film: &Film, source: impl Into<PathBuf>) -> Image {
+        Image::from_film_channels(film, source.into(), |_| true)
+    }
+
+    /// Code values as stored: a PNG is compared as the bytes a viewer shows.
+    pub fn from_rgb8(picture: RgbImage, source: impl Into<PathBuf>) -> Image {
+        let plane = |c: usize| picture.pixels().map(|p| f32::from(p.0[c])).collect();
+        Image {
+            source: source.into(),
+            encoding: Encoding::Code8,
+            width: picture.width(),
+            height: picture.height(),
+            channels: COLOR_CHANNELS
+                .iter()
+                .enumerate()
+                .map(|(c, &name)| Channel {
+                    name,
+                    values: plane(c),
+                })
+                .collect(),
+            preview: picture,
+        }
+    }
+
+    /// Keeps only the film channels the file really has: the film reader fills absent AOVs with
+    /// "miss" values, and comparing those invented values would hide a channel-set mismatch.
+    pub fn from_exr_bytes(bytes: &[u8], source: impl Into<PathBuf>) -> Result<Image, CompareError> {
+        let source = source.into();
+        let meta =
+            MetaData::read_from_buffered(bytes, false).map_err(|e| CompareError::ExrHeader {
+                path: source.clone(),
+                source: e,
+            })?;
+        let film = decode_exr(bytes).map_err(|e| CompareError::Exr {
+            path: source.clone(),
+            source: e,
+        })?;
+        let present = |name: &str| {
+            meta.headers
+                .first()
+                .is_some_and(|header| header.channels.list.iter().any(|c| c.name == *name))
+        };
+        Ok(Image::from_film_channels(&film, source, present))
+    }
+
+    pub fn from_png_bytes(bytes: &[u8], source: impl Into<PathBuf>) -> Result<Image, CompareError> {
+        let source = source.into();
+        let decoded =
+            image::load_from_memory_with_format(bytes, image::ImageFormat::Png).map_err(|e| {
+                CompareError::Png {
+                    path: source.clone(),
+                    source: e,
+                }
+            })?;
+        Ok(Image::from_rgb8(decoded.into_rgb8(), source))
+    }
+
+    /// Decides EXR or PNG by the file's signature, not its name, so that a misnamed file is read
+    /// for what it is.
+    pub fn read(path: &Path) -> Result<Image, CompareError> {
+        let bytes = std::fs::read(path).map_err(|e| CompareError::Read {
+            path: path.to_path_buf(),
+            source: e,
+        })?;
+        if bytes.starts_with(&EXR_MAGIC) {
+            Image::from_exr_bytes(&bytes, path)
+        } else if bytes.starts_with(&PNG_MAGIC) {
+            Image::from_png_bytes(&bytes, path)
+        } else {
+            Err(CompareError::UnknownFormat {
+                path: path.to_path_buf(),
+            })
+        }
+    }
+
+    pub fn channel_names(&self) -> Vec<&'static str> {
+        self.channels.iter().map(|c| c.name).collect()
+    }
+
+    pub fn pixels(&self) -> usize {
+        self.width as usize * self.height as usize
+    }
+
+    fn from_film_channels(film: &Film, source: PathBuf, keep: impl Fn(&str) -> bool) -> Image {
+        let pick = |values: &[[f32; 3]], c: usize| values.iter().map(|v| v[c]).collect();
+        let planes: [Vec<f32>; 7] = [
+            pick(&film.color, 0),
+            pick(&film.color, 1),
+            pick(&film.color, 2),
+            film.depth.clone(),
+            pick(&film.normal, 0),
+            pick(&film.normal, 1),
+            pick(&film.normal, 2),
+        ];
+        let channels = FILM_CHANNELS
+            .into_iter()
+            .zip(planes)
+            .filter(|(name, _)| keep(name))
+            .map(|(name, values)| Channel { name, values })
+            .collect();
+        Image {
+            source,
+            encoding: Encoding::Linear,
+            width: film.width,
+            height: film.height,
+            channels,
+            preview: color_image(film, Tonemap::Srgb),
+        }
+    }
+}

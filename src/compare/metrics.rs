@@ -1,0 +1,218 @@
+//! The numbers a comparison is judged on. Every channel value pair is classified before any
+//! arithmetic, because `NaN > threshold` is false: a NaN that reached a subtraction would make a
+//! broken pixel look perfect.
+
+use serde::Serialize;
+
+use super::image::{COLOR_CHANNELS, Channel, Encoding, Image};
+
+/// One channel of one pixel in both images.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct PixelError {
+    pub x: u32,
+    pub y: u32,
+    pub channel: &'static str,
+    pub expected: f32,
+    pub actual: f32,
+}
+
+impl PixelError {
+    /// `|expected − actual|`, infinite when exactly one side is non-finite.
+    pub fn error(&self) -> f64 {
+        match difference(self.expected, self.actual, true) {
+            Difference::Finite(d) => d,
+            Difference::Coverage | Difference::Broken => f64::INFINITY,
+        }
+    }
+}
+
+/// How one value pair compares.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) enum Difference {
+    /// Both finite (or the same non-finite value on both sides): the absolute difference.
+    Finite(f64),
+    /// A depth hit on one side and a miss (`+inf`) on the other: a silhouette moved.
+    Coverage,
+    /// NaN or infinity on one side only, where no valid render produces it.
+    Broken,
+}
+
+pub(super) fn difference(expected: f32, actual: f32, infinity_is_a_value: bool) -> Difference {
+    if expected.is_finite() && actual.is_finite() {
+        return Difference::Finite((f64::from(expected) - f64::from(actual)).abs());
+    }
+    if expected == actual || (expected.is_nan() && actual.is_nan()) {
+        return Difference::Finite(0.0);
+    }
+    let miss_or_hit = |v: f32| v.is_finite() || v == f32::INFINITY;
+    if infinity_is_a_value && miss_or_hit(expected) && miss_or_hit(actual) {
+        Difference::Coverage
+    } else {
+        Difference::Broken
+    }
+}
+
+impl Difference {
+    pub(super) fn exceeds(self, threshold: f64) -> bool {
+        match self {
+            Difference::Finite(d) => d > threshold,
+            Difference::Coverage | Difference::Broken => true,
+        }
+    }
+}
+
+/// Per-channel findings, so that a report can say "the depth moved" rather than only "something".
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ChannelStats {
+    pub name: &'static str,
+    /// Pixels where this channel differs by more than the pixel threshold.
+    pub failing: usize,
+    /// The largest difference (a silhouette change counts as infinite); `None` when identical.
+    pub worst: Option<PixelError>,
+}
+
+/// Values that are NaN or infinite in one image and not in the other.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct NonFinite {
+    /// Channel values, not pixels: one NaN pixel in R and G counts 2.
+    pub count: usize,
+    pub first: PixelError,
+}
+
+/// The measurements of one image pair. MAE, RMSE, PSNR and `worst` are over colour (R, G, B) in
+/// the images' units (linear values for EXR, 8-bit codes for PNG); the failing-pixel count looks
+/// at every channel, AOVs included.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Metrics {
+    pub encoding: Encoding,
+    pub pixels: usize,
+    pub pixel_threshold: f64,
+    /// Pixels with any channel beyond `pixel_threshold`, a moved silhouette or a broken value.
+    pub failing_pixels: usize,
+    pub failing_fraction: f64,
+    pub mae: f64,
+    pub rmse: f64,
+    /// In dB against the encoding's peak (1 or 255); infinite for identical colour.
+    pub psnr: f64,
+    /// NVIDIA's FLIP, mean over the picture of the sRGB 8-bit colour: 0 identical, 1 opposite.
+    pub flip: f64,
+    /// The largest colour difference; `None` when colour is identical.
+    pub worst: Option<PixelError>,
+    pub channels: Vec<ChannelStats>,
+    pub non_finite: Option<NonFinite>,
+}
+
+/// Both images must have the same size and channel list (`compare` checks that first).
+pub(super) fn measure(expected: &Image, actual: &Image, pixel_threshold: f64) -> Metrics {
+    let width = expected.width as usize;
+    let pixels = expected.pixels();
+    let mut failing = vec![false; pixels];
+    let mut channels = Vec::with_capacity(expected.channels.len());
+    let mut non_finite: Option<NonFinite> = None;
+    let (mut sum_abs, mut sum_sq) = (0.0_f64, 0.0_f64);
+
+    for (e, a) in expected.channels.iter().zip(&actual.channels) {
+        let is_color = COLOR_CHANNELS.contains(&e.name);
+        let mut stats = ChannelStats {
+            name: e.name,
+            failing: 0,
+            worst: None,
+        };
+        let mut worst_error = 0.0_f64;
+        for (i, (&ev, &av)) in e.values.iter().zip(&a.values).enumerate() {
+            let at = || PixelError {
+                x: (i % width) as u32,
+                y: (i / width) as u32,
+                channel: e.name,
+                expected: ev,
+                actual: av,
+            };
+            let diff = difference(ev, av, e.infinity_is_a_value());
+            if diff.exceeds(pixel_threshold) {
+                stats.failing += 1;
+                failing[i] = true;
+            }
+            let error = match diff {
+                Difference::Finite(d) => d,
+                Difference::Coverage => f64::INFINITY,
+                Difference::Broken => {
+                    match &mut non_finite {
+                        Some(found) => found.count += 1,
+                        None => {
+                            non_finite = Some(NonFinite {
+                                count: 1,
+                                first: at(),
+                            })
+                        }
+                    }
+                    continue;
+                }
+            };
+            if is_color {
+                sum_abs += error;
+                sum_sq += error * error;
+            }
+            if error > worst_error {
+                worst_error = error;
+                stats.worst = Some(at());
+            }
+        }
+        channels.push(stats);
+    }
+
+    let color_values = (pixels * COLOR_CHANNELS.len()).max(1) as f64;
+    let mse = sum_sq / color_values;
+    let peak = expected.encoding.peak();
+    let failing_pixels = failing.iter().filter(|&&f| f).count();
+    Metrics {
+        encoding: expected.encoding,
+        pixels,
+        pixel_threshold,
+        failing_pixels,
+        failing_fraction: failing_pixels as f64 / pixels.max(1) as f64,
+        mae: sum_abs / color_values,
+        rmse: mse.sqrt(),
+        psnr: if mse == 0.0 {
+            f64::INFINITY
+        } else {
+            10.0 * (peak * peak / mse).log10()
+        },
+        flip: super::flip::flip_mean(&expected.preview, &actual.preview),
+        worst: worst_color(&channels),
+        channels,
+        non_finite,
+    }
+}
+
+fn worst_color(channels: &[ChannelStats]) -> Option<PixelError> {
+    largest(
+        channels
+            .iter()
+            .filter(|c| COLOR_CHANNELS.contains(&c.name))
+            .filter_map(|c| c.worst),
+    )
+}
+
+/// The largest error, the earliest on a tie so that reports are stable.
+pub(super) fn largest(errors: impl Iterator<Item = PixelError>) -> Option<PixelError> {
+    errors.fold(None, |best, p| match best {
+        Some(b) if b.error() >= p.error() => Some(b),
+        _ => Some(p),
+    })
+}
+
+/// The channels two images must share to be compared at all.
+pub(super) fn same_layout(expected: &Image, actual: &Image) -> bool {
+    let complete = |image: &Image| {
+        image
+            .channels
+            .iter()
+            .all(|c: &Channel| c.values.len() == image.pixels())
+    };
+    expected.width == actual.width
+        && expected.height == actual.height
+        && expected.encoding == actual.encoding
+        && expected.channel_names() == actual.channel_names()
+        && complete(expected)
+        && complete(actual)
+}

@@ -1,0 +1,33 @@
+//! Comparing a render against its golden image: metrics, tolerance verdicts and diff heatmaps.
+//!
+//! EXR films are compared on linear values, channel by channel (colour, depth and normals); PNGs
+//! on 8-bit code values. The golden suite (`tests/golden.rs`) and `goldray diff` both go through
+//! [`compare`], so a verdict in CI and one at the shell always agree.
+//!
+//! ```no_run
+//! use goldray::compare::{Image, compare, EXR_DEFAULTS};
+//! # fn main() -> Result<(), goldray::compare::CompareError> {
+//! let expected = Image::read("golden/spheres_shadows.snap.exr".as_ref())?;
+//! let actual = Image::read("out/spheres_shadows.exr".as_ref())?;
+//! let comparison = compare(&expected, &actual, &EXR_DEFAULTS);
+//! println!("{comparison}");
+//! # Ok(())
+//! # }
+//! ```
+
+mod cli;
+mod comparison;
+mod error;
+mod flip;
+mod heatmap;
+mod image;
+mod metrics;
+mod verdict;
+
+pub use cli::{DiffArgs, EXR_DEFAULTS, PNG_DEFAULTS, UNREADABLE, diff_files, run_diff};
+pub use comparison::{Comparison, compare};
+pub use error::CompareError;
+pub use heatmap::{FAILING, NON_FINITE, diff_heatmap};
+pub use image::{COLOR_CHANNELS, Channel, Encoding, Image};
+pub use metrics::{ChannelStats, Metrics, NonFinite, PixelError};
+pub use verdict::{Breach, Layout, Limit, Verdict};

@@ -1,0 +1,274 @@
+//! The golden suite: every `cases/*.toml` is rendered and compared with its snapshot in `golden/`
+//! within the case's `[tolerance]`, so that a change that breaks a picture fails loudly and one
+//! that moves a value by an ulp does not.
+//!
+//! Snapshots are insta binary snapshots (`golden/NAME.snap` + `golden/NAME.snap.exr`) judged by
+//! [`comparator::ToleranceComparator`] instead of byte equality. insta decides what is written:
+//! nothing under `CI=true`, `golden/NAME.snap.new*` for `cargo insta review` locally, the golden
+//! itself with `INSTA_UPDATE=always`. A snapshot within tolerance is never rewritten, so goldens
+//! do not churn with platform noise.
+
+#[path = "golden/comparator.rs"]
+mod comparator;
+
+use std::fs;
+use std::panic::{self, AssertUnwindSafe};
+use std::path::{Path, PathBuf};
+
+use rayon::prelude::*;
+
+use goldray::case::{Case, LoadOptions, load};
+use goldray::film::{Film, Tonemap, color_image, encode_exr, write_png};
+use goldray::pipeline::render_case;
+
+use comparator::{Judged, ToleranceComparator};
+
+const ROOT: &str = env!("CARGO_MANIFEST_DIR");
+
+fn cases_dir() -> PathBuf {
+    Path::new(ROOT).join("cases")
+}
+
+fn golden_dir() -> PathBuf {
+    Path::new(ROOT).join("golden")
+}
+
+/// Heatmaps and previews of failing cases go beside the build, never into the source tree, so a
+/// CI run writes nothing a commit could pick up.
+fn diffs_dir() -> PathBuf {
+    let tmp = Path::new(env!("CARGO_TARGET_TMPDIR"));
+    tmp.parent().unwrap_or(tmp).join("golden-diffs")
+}
+
+/// A path relative to the project root when it is inside it, so messages stay short.
+pub fn shown(path: &Path) -> String {
+    path.strip_prefix(ROOT)
+        .unwrap_or(path)
+        .display()
+        .to_string()
+}
+
+/// Sorted, so that failures are reported in the same order on every run.
+fn case_files() -> Vec<PathBuf> {
+    let entries = fs::read_dir(cases_dir())
+        .unwrap_or_else(|e| panic!("cannot list {}: {e}", shown(&cases_dir())));
+    let mut files: Vec<PathBuf> = entries
+        .filter_map(|entry| entry.ok().map(|e| e.path()))
+        .filter(|path| path.extension().is_some_and(|ext| ext == "toml"))
+        .collect();
+    files.sort();
+    files
+}
+
+struct Rendered {
+    case: Case,
+    film: Film,
+    exr: Vec<u8>,
+}
+
+/// Loads, renders and encodes one case; an error is the message to fail with.
+fn render(path: &Path) -> Result<Rendered, String> {
+    let name = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    if name.is_empty()
+        || !name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+    {
+        return Err(format!(
+            "{}: a case name may only hold letters, digits, `_` and `-` (it names the snapshot file); rename the file",
+            shown(path)
+        ));
+    }
+    let case = load(path, &LoadOptions::default())
+        .map_err(|e| explain_missing_shared(path, e.to_string(), &shared_dir()))?;
+    let film = render_case(&case, false)
+        .map_err(|e| explain_missing_shared(path, e.to_string(), &shared_dir()))?;
+    let exr = encode_exr(&film).map_err(|e| format!("{}: {e}", shown(path)))?;
+    Ok(Rendered { case, film, exr })
+}
+
+/// The course's scenes and assets live in `shared/` beside the project; when a case that reads
+/// them fails and that directory is absent, say so instead of leaving a bare "file not found".
+fn explain_missing_shared(case: &Path, message: String, shared: &Path) -> String {
+    let uses_shared = fs::read_to_string(case).is_ok_and(|text| text.contains("shared/"));
+    if uses_shared && !shared.is_dir() {
+        format!(
+            "{message}\n  this case reads the course's files from {}, which is missing: put the shared/ directory \
+             beside the project root to run it",
+            shared.display()
+        )
+    } else {
+        message
+    }
+}
+
+fn shared_dir() -> PathBuf {
+    Path::new(ROOT).join("../shared")
+}
+
+#[test]
+fn every_case_matches_its_golden_image() {
+    let files = case_files();
+    assert!(
+        !files.is_empty(),
+        "no cases found in {}",
+        shown(&cases_dir())
+    );
+    // Rendering is the slow part and needs no insta state, so it runs on every core; the
+    // assertions then run one by one on this thread, where insta's settings are bound.
+    let rendered: Vec<Result<Rendered, String>> =
+        files.par_iter().map(|path| render(path)).collect();
+    let mut failures: Vec<String> = rendered
+        .into_iter()
+        .filter_map(|result| result.and_then(|r| check(&r)).err())
+        .collect();
+    failures.extend(orphan_goldens(&files));
+
+    assert!(
+        failures.is_empty(),
+        "{} of {} golden cases failed:\n\n{}",
+        failures.len(),
+        files.len(),
+        failures.join("\n\n")
+    );
+}
+
+/// Runs the insta assertion for one case under the tolerance comparator and turns its outcome
+/// into a message a person can act on.
+fn check(rendered: &Rendered) -> Result<(), String> {
+    let case = &rendered.case;
+    let name = &case.name;
+    let golden = golden_dir().join(format!("{name}.snap"));
+    let golden_exr = PathBuf::from(shown(&golden.with_extension("snap.exr")));
+    let comparator = ToleranceComparator::new(name, &case.tolerance, &golden_exr, &diffs_dir());
+    let judged = comparator.judged();
+
+    let mut settings = insta::Settings::clone_current();
+    settings.set_snapshot_path(golden_dir());
+    settings.set_prepend_module_to_snapshot(false);
+    settings.set_omit_expression(true);
+    settings.set_description(case.description.clone().unwrap_or_else(|| name.clone()));
+    settings.set_comparator(Box::new(comparator));
+    let snapshot = format!("{name}.exr");
+    let asserted = panic::catch_unwind(AssertUnwindSafe(|| {
+        settings.bind(|| insta::assert_binary_snapshot!(snapshot.as_str(), rendered.exr.clone()));
+    }));
+
+    let judged = judged.lock().map(|mut slot| slot.take()).unwrap_or(None);
+    match (asserted, judged) {
+        (Ok(()), Some(Judged::Compared(comparison))) if !comparison.verdict.accepts() => {
+            eprintln!(
+                "rewrote the golden of case {name} (INSTA_UPDATE); it differed by:\n{comparison}"
+            );
+            Ok(())
+        }
+        (Ok(()), Some(Judged::Compared(comparison)))
+            if comparison
+                .metrics
+                .as_ref()
+                .is_some_and(|m| m.failing_pixels > 0) =>
+        {
+            eprintln!(
+                "warning: case {name} is within tolerance but some pixels moved:\n{comparison}"
+            );
+            Ok(())
+        }
+        (Ok(()), _) => Ok(()),
+        (Err(_), judged) => {
+            if judged.is_none() {
+                let preview = diffs_dir().join(format!("{name}.actual.png"));
+                let _ = write_png(&preview, &color_image(&rendered.film, Tonemap::Srgb));
+            }
+            Err(failure_message(case, &golden, judged))
+        }
+    }
+}
+
+fn failure_message(case: &Case, golden: &Path, judged: Option<Judged>) -> String {
+    let name = &case.name;
+    let actual_png = diffs_dir().join(format!("{name}.actual.png"));
+    let case_file = shown(&case.path);
+    let preview = shown(&actual_png);
+    let pending = if is_ci() {
+        "CI=true, so nothing was written: run the suite locally to get a pending snapshot"
+            .to_owned()
+    } else {
+        format!("pending as {}.new", shown(golden))
+    };
+    let accept = format!(
+        "accept it with `cargo insta review` ({pending}) or `INSTA_UPDATE=always cargo test --release --test golden`"
+    );
+    match judged {
+        None => format!(
+            "case {name} ({case_file}) has no golden image {}.\n  look at {preview}; if it is right, {accept}, \
+             then commit golden/{name}.snap and golden/{name}.snap.exr",
+            shown(golden)
+        ),
+        Some(Judged::Unreadable(message)) => format!(
+            "case {name} ({case_file}): {message}\n  if the new render ({preview}) is right, {accept}"
+        ),
+        Some(Judged::Compared(comparison)) => {
+            format!(
+                "case {name} ({case_file}): {comparison}  if the change is intended, compare {preview} with its \
+                 .expected.png, then {accept}"
+            )
+        }
+    }
+}
+
+/// A golden without a case would never be checked again; say so rather than keep dead files.
+fn orphan_goldens(case_files: &[PathBuf]) -> Vec<String> {
+    let Ok(entries) = fs::read_dir(golden_dir()) else {
+        return Vec::new();
+    };
+    let mut orphans: Vec<String> = entries
+        .filter_map(|entry| entry.ok().map(|e| e.path()))
+        .filter(|path| path.extension().is_some_and(|ext| ext == "snap"))
+        .filter_map(|path| {
+            let stem = path.file_stem()?.to_string_lossy().into_owned();
+            let has_case = case_files.iter().any(|case| {
+                case.file_stem()
+                    .is_some_and(|s| s.to_string_lossy() == stem)
+            });
+            (!has_case).then(|| {
+                format!(
+                    "{} has no case cases/{stem}.toml: delete it and {}.exr, or restore the case",
+                    shown(&path),
+                    shown(&path)
+                )
+            })
+        })
+        .collect();
+    orphans.sort();
+    orphans
+}
+
+/// insta's own reading of `CI`, so the message matches what insta did.
+fn is_ci() -> bool {
+    !matches!(
+        std::env::var("CI").as_deref(),
+        Err(_) | Ok("" | "0" | "false")
+    )
+}
+
+#[test]
+fn a_case_that_needs_the_missing_shared_directory_says_so() {
+    let dir = tempfile::tempdir().expect("a temporary directory");
+    let case = dir.path().join("course.toml");
+    fs::write(
+        &case,
+        "[[object]]\nkind = \"mesh\"\nobj = \"../../shared/mit6837/bunny.obj\"\n",
+    )
+    .expect("written");
+    let message =
+        explain_missing_shared(&case, "no such file".to_owned(), &dir.path().join("shared"));
+    assert!(
+        message.starts_with("no such file\n") && message.contains("is missing"),
+        "{message}"
+    );
+    let present = explain_missing_shared(&case, "no such file".to_owned(), dir.path());
+    assert_eq!(present, "no such file");
+}
