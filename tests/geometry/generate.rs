@@ -45,8 +45,9 @@ fn blob_is_closed_and_consistently_wound_outwards() {
     }
 }
 
-/// Also at the extremes of scale the scenes will use, and moved away from the origin, where
-/// coordinates carry less precision relative to the blob's size.
+/// Watertightness: 100,000 rays (20,000 per placement) from inside a closed, irregular,
+/// 20,480-triangle mesh all hit it, also at the extremes of scale the scenes will use and moved
+/// away from the origin, where coordinates carry less precision relative to the blob's size.
 #[test]
 fn rays_from_inside_always_hit() {
     let (unit_positions, triangles) = blob(5, 3);
@@ -62,7 +63,7 @@ fn rays_from_inside_always_hit() {
         let centre = Vec3::new(offset, -0.5 * offset, 0.25 * offset);
         let positions: Vec<Vec3> = unit_positions.iter().map(|&p| centre + p * scale).collect();
         let mesh = Mesh::new(&positions, &triangles, VertexNormals::Averaged).unwrap();
-        for i in 0..5_000 {
+        for i in 0..20_000 {
             let inside = rng.direction() * rng.uniform(0.0, 0.95 * BLOB_MIN_RADIUS);
             let ray = Ray::new(
                 centre + inside * scale,
