@@ -129,10 +129,7 @@ pub fn parse_assignment_scene(
         background.color = [0.0; 3];
     }
     Ok(Case {
-        name: path
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default(),
+        name: super::case_name(path),
         path: path.to_path_buf(),
         description: None,
         render,

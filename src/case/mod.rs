@@ -76,10 +76,7 @@ pub fn parse(source: &str, path: &Path, options: &LoadOptions) -> Result<Case, C
     top.check_keys(TOP_LEVEL_KEYS)?;
     let materials = sections::materials(top.get("materials"))?;
     Ok(Case {
-        name: path
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default(),
+        name: case_name(path),
         path: path.to_path_buf(),
         description: top.read("description", None, |f| {
             f.string().map(|s| Some(s.to_owned()))
@@ -92,4 +89,9 @@ pub fn parse(source: &str, path: &Path, options: &LoadOptions) -> Result<Case, C
         objects: top.read("object", Vec::new(), |f| objects::objects(f, &materials))?,
         materials,
     })
+}
+
+/// A case is named after its file's stem: `cases/spheres.toml` renders `spheres.exr`.
+pub(crate) fn case_name(path: &Path) -> String {
+    path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
 }
