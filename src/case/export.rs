@@ -234,20 +234,37 @@ impl Writer<'_> {
 
     fn path(&self, path: &Path) -> String {
         relative(path, self.base).unwrap_or_else(|| {
-            let absolute = std::fs::canonicalize(path)
-                .or_else(|_| std::path::absolute(path))
-                .unwrap_or_else(|_| path.to_path_buf());
-            absolute.to_string_lossy().into_owned()
+            lexical_absolute(path)
+                .unwrap_or_else(|| path.to_path_buf())
+                .to_string_lossy()
+                .into_owned()
         })
     }
+}
+
+/// The absolute form of `path` with `.` and `..` resolved as written, not through symlinks: a
+/// `../shared` that is a link stays `../shared` in the case, as the user wrote it, instead of
+/// becoming the link's target, which only exists on this machine.
+fn lexical_absolute(path: &Path) -> Option<PathBuf> {
+    let mut resolved = PathBuf::new();
+    for component in std::path::absolute(path).ok()?.components() {
+        match component {
+            std::path::Component::CurDir => {}
+            std::path::Component::ParentDir => {
+                resolved.pop();
+            }
+            other => resolved.push(other),
+        }
+    }
+    Some(resolved)
 }
 
 /// `target` relative to the directory `base`, with `/` separators so that the case file works on
 /// every platform; `None` when either cannot be resolved or they share nothing below the root,
 /// where a chain of `..` would be more fragile than an absolute path.
 fn relative(target: &Path, base: &Path) -> Option<String> {
-    let target = std::fs::canonicalize(target).ok()?;
-    let base = std::fs::canonicalize(base).ok()?;
+    let target = lexical_absolute(target)?;
+    let base = lexical_absolute(base)?;
     let common = target
         .components()
         .zip(base.components())
