@@ -15,15 +15,17 @@ mod rubrics;
 
 use std::collections::BTreeMap;
 use std::fs;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 use std::time::Instant;
 
 use goldray::grade::{ClassReport, GradeOptions, Outcome, StudentResult, grade_class};
 
-use class::{Class, FILES, HOSTILE, POINTS, make_class};
+use class::{Class, FILES, HOSTILE, POINTS, make_class_at};
 
-/// The class graded once and shared by the tests that only read the report.
+/// The class graded once and shared by the tests that only read the report. It lives in
+/// `target/tmp/grade-class/` (replaced by each run), so that the report can be opened after the
+/// tests: `target/tmp/grade-class/report/index.html`.
 struct Graded {
     class: Class,
     out: PathBuf,
@@ -34,8 +36,8 @@ struct Graded {
 fn graded() -> &'static Graded {
     static GRADED: OnceLock<Graded> = OnceLock::new();
     GRADED.get_or_init(|| {
-        let class = make_class();
-        let out = class.dir.path().join("report");
+        let class = make_class_at(&Path::new(env!("CARGO_TARGET_TMPDIR")).join("grade-class"));
+        let out = class.dir.join("report");
         let options = GradeOptions {
             out: out.clone(),
             cache: None,

@@ -20,8 +20,9 @@ pub const HOSTILE: &str = "<img src=x onerror=alert(1)> & \"Mallory\"";
 type Files = Vec<(&'static str, Vec<u8>)>;
 
 pub struct Class {
-    /// Keeps everything alive for the tests sharing the class.
-    pub dir: tempfile::TempDir,
+    pub dir: PathBuf,
+    /// Removes `dir` when the class is dropped, for a class in a temporary directory.
+    _temporary: Option<tempfile::TempDir>,
     pub rubric: PathBuf,
     pub submissions: PathBuf,
     /// Every student file with its bytes, to prove grading changes none of them.
@@ -143,12 +144,23 @@ fn crc32(bytes: &[u8]) -> u32 {
     !crc
 }
 
-/// Writes the rubric and every student's folder under a fresh temporary directory.
+/// The class in a fresh temporary directory, removed with the `Class`.
 pub fn make_class() -> Class {
-    let dir = tempfile::tempdir().unwrap();
-    let rubric = dir.path().join("rubric.toml");
+    let temporary = tempfile::tempdir().unwrap();
+    let mut class = make_class_at(temporary.path());
+    class._temporary = Some(temporary);
+    class
+}
+
+/// The class in `dir`, emptied first and kept afterwards, so that its report can be looked at.
+pub fn make_class_at(dir: &Path) -> Class {
+    if dir.exists() {
+        fs::remove_dir_all(dir).unwrap();
+    }
+    fs::create_dir_all(dir).unwrap();
+    let rubric = dir.join("rubric.toml");
     fs::write(&rubric, rubric_text(&scene_path())).unwrap();
-    let submissions = dir.path().join("submissions");
+    let submissions = dir.join("submissions");
 
     let base = case();
     let golden = render(&base);
@@ -241,7 +253,8 @@ pub fn make_class() -> Class {
         fs::write(path, bytes).unwrap();
     }
     Class {
-        dir,
+        dir: dir.to_path_buf(),
+        _temporary: None,
         rubric,
         submissions,
         files,

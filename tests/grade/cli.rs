@@ -11,10 +11,10 @@ use crate::class::make_class;
 #[test]
 fn goldens_are_rendered_once_then_read_from_the_cache() {
     let class = make_class();
-    let cache = class.dir.path().join("cache");
+    let cache = class.dir.join("cache");
     let grade = |out: &str| {
         let options = GradeOptions {
-            out: class.dir.path().join(out),
+            out: class.dir.join(out),
             cache: Some(cache.clone()),
             show_progress: false,
         };
@@ -48,7 +48,7 @@ fn goldray(args: &[&str]) -> std::process::Output {
 #[test]
 fn the_command_exits_0_whatever_the_grades_and_1_when_it_cannot_grade() {
     let class = make_class();
-    let out = class.dir.path().join("cli-report");
+    let out = class.dir.join("cli-report");
     let path = |p: &Path| p.to_str().unwrap().to_owned();
     let run = goldray(&[
         "grade",
@@ -82,7 +82,7 @@ fn the_command_exits_0_whatever_the_grades_and_1_when_it_cannot_grade() {
     assert_eq!(missing.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&missing.stderr).contains("/nonexistent/submissions"));
 
-    let bad = class.dir.path().join("bad.toml");
+    let bad = class.dir.join("bad.toml");
     fs::write(
         &bad,
         fs::read_to_string(&class.rubric)
