@@ -1,6 +1,6 @@
 //! goldray: a deterministic Whitted-style ray tracer and a scene-to-image regression harness.
 //!
-//! Data flows one way: case → scene → render → film → outputs → compare.
+//! Data flows one way: case → scene → render → film → outputs → compare → grade.
 
 pub mod assignment_outputs;
 pub mod case;
@@ -8,6 +8,7 @@ pub mod compare;
 pub mod error;
 pub mod film;
 pub mod geometry;
+pub mod grade;
 pub mod pipeline;
 pub mod real;
 pub mod render;

@@ -76,6 +76,9 @@ enum Command {
     /// Compare two EXR or PNG images within a tolerance. Exit code: 0 pass, 1 warn (some pixels
     /// over --pixel, every limit kept), 2 fail, 3 size or channel mismatch, 4 unreadable file.
     Diff(goldray::compare::DiffArgs),
+    /// Grade folders of student renders against a rubric's golden images: writes grades.csv,
+    /// grades.json and an HTML report. Exit code 0 whenever grading ran, whatever the grades.
+    Grade(goldray::grade::GradeArgs),
 }
 
 /// The course binary's rendering flags, shared by `mit6837` and `import` so that an imported
@@ -187,6 +190,7 @@ fn run(cli: Cli) -> Result<ExitCode, String> {
             .map(|()| ExitCode::SUCCESS)
         }
         Command::Diff(args) => Ok(ExitCode::from(goldray::compare::run_diff(&args))),
+        Command::Grade(args) => goldray::grade::run_grade(&args).map(|_| ExitCode::SUCCESS).map_err(|e| e.to_string()),
     }
 }
 

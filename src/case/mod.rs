@@ -28,7 +28,10 @@ pub use spec::{
     ShapeSpec, Tolerance, TransformOp, composite_matrix,
 };
 
-use value::{Doc, Table};
+// The located TOML readers and the key suggestions, shared with the grading rubric so that both
+// files report mistakes the same way.
+pub(crate) use error::suggest;
+pub(crate) use value::{Doc, Field, Table};
 
 #[derive(Clone, Debug, Default)]
 pub struct LoadOptions {

@@ -1,0 +1,181 @@
+//! Golden images: each distinct render of a rubric is rendered once per grading run, however many
+//! students and images use it, and kept in an on-disk cache so that grading the next batch (or
+//! regrading after a rubric tweak) does not render it again.
+//!
+//! A cache entry is the render's linear EXR, named by a hash of everything that decides its
+//! pixels: the loaded case (its Debug text: camera, objects, materials, render settings, all
+//! numbers in round-trip precision), the bytes of the assets it reads (OBJ meshes, cube-map
+//! faces), goldray's version and the running executable itself. The last one matters during
+//! development, when the renderer changes without a version bump; a stale golden would silently
+//! grade every student against the wrong picture.
+
+use std::collections::HashMap;
+use std::fs;
+use std::hash::{DefaultHasher, Hash, Hasher};
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+use std::time::Instant;
+
+use image::RgbImage;
+use serde::Serialize;
+
+use super::error::GradeError;
+use super::rubric::{Output, Rubric};
+use crate::case::{Case, ObjectSpec, ShapeSpec};
+use crate::compare::Image;
+use crate::film::{
+    Film, color_image, decode_exr, depth_image, encode_exr, normals_image, write_file_atomic, write_png,
+};
+use crate::pipeline::render_case;
+
+/// Where the report keeps the golden PNGs, relative to the report directory.
+pub const GOLDEN_DIR: &str = "golden";
+
+/// How one render of the rubric was obtained, for the JSON report.
+#[derive(Clone, Debug, Serialize)]
+pub struct GoldenRender {
+    pub render: String,
+    /// The cache key: the EXR is `CACHE/KEY.exr`.
+    pub key: String,
+    /// Read from the cache rather than rendered.
+    pub cached: bool,
+    /// Rendering (or reading) time.
+    pub seconds: f64,
+    /// Why the render could not be cached, if it could not; grading goes on without the cache.
+    pub cache_note: Option<String>,
+}
+
+/// The golden pictures in rubric order, as 8-bit images ready to compare.
+pub struct Goldens {
+    pub renders: Vec<GoldenRender>,
+    /// Parallel to `Rubric::images`.
+    pub images: Vec<Image>,
+}
+
+/// Renders (or loads from `cache_dir`) every render an image uses, and writes each golden picture
+/// to `REPORT/golden/FILE` for the HTML report.
+pub fn prepare_goldens(
+    rubric: &Rubric,
+    cache_dir: &Path,
+    report_dir: &Path,
+    show_progress: bool,
+) -> Result<Goldens, GradeError> {
+    let mut films: HashMap<usize, Film> = HashMap::new();
+    let mut by_key: HashMap<String, usize> = HashMap::new();
+    let mut renders = Vec::new();
+    for spec in &rubric.images {
+        let index = spec.render_index;
+        if films.contains_key(&index) {
+            continue;
+        }
+        let source = &rubric.renders[index];
+        let started = Instant::now();
+        let key = cache_key(&source.case);
+        // Two differently named renders with the same content are one render.
+        if let Some(&same) = by_key.get(&key) {
+            let film = films[&same].clone();
+            films.insert(index, film);
+            continue;
+        }
+        let path = cache_dir.join(format!("{key}.exr"));
+        let (film, cached, cache_note) = match read_cached(&path, &source.case) {
+            Some(film) => (film, true, None),
+            None => {
+                let film = render_case(&source.case, show_progress).map_err(|source_error| GradeError::Golden {
+                    location: source.location.clone(),
+                    render: source.name.clone(),
+                    source: Box::new(source_error),
+                })?;
+                let note = store(&path, &film).err();
+                (film, false, note)
+            }
+        };
+        renders.push(GoldenRender {
+            render: source.name.clone(),
+            key: key.clone(),
+            cached,
+            seconds: started.elapsed().as_secs_f64(),
+            cache_note,
+        });
+        by_key.insert(key, index);
+        films.insert(index, film);
+    }
+
+    let mut images = Vec::with_capacity(rubric.images.len());
+    for spec in &rubric.images {
+        let film = &films[&spec.render_index];
+        let tonemap = rubric.renders[spec.render_index].case.render.tonemap;
+        let picture: RgbImage = match spec.output {
+            Output::Color => color_image(film, tonemap),
+            Output::Normals => normals_image(film, tonemap),
+            Output::Depth { min, max } => depth_image(film, min as f32, max as f32, tonemap),
+        };
+        let path = report_dir.join(GOLDEN_DIR).join(&spec.file);
+        write_png(&path, &picture)?;
+        images.push(Image::from_rgb8(picture, path));
+    }
+    Ok(Goldens { renders, images })
+}
+
+/// The cached film, if there is a readable one of the right size. A damaged entry is treated as
+/// absent and rendered again, which also repairs it.
+fn read_cached(path: &Path, case: &Case) -> Option<Film> {
+    let bytes = fs::read(path).ok()?;
+    let film = decode_exr(&bytes).ok()?;
+    (film.width == case.render.width && film.height == case.render.height).then_some(film)
+}
+
+fn store(path: &Path, film: &Film) -> Result<(), String> {
+    let bytes = encode_exr(film).map_err(|e| e.to_string())?;
+    write_file_atomic(path, &bytes).map_err(|e| e.to_string())
+}
+
+/// 16 hex digits naming a render's pixels (see the module documentation). Assets that cannot be
+/// read are hashed as absent: the render itself will then fail and say why.
+pub fn cache_key(case: &Case) -> String {
+    let mut hasher = DefaultHasher::new();
+    env!("CARGO_PKG_VERSION").hash(&mut hasher);
+    build_identity().hash(&mut hasher);
+    format!("{case:?}").hash(&mut hasher);
+    for asset in assets(case) {
+        asset.hash(&mut hasher);
+        fs::read(&asset).ok().hash(&mut hasher);
+    }
+    format!("{:016x}", hasher.finish())
+}
+
+/// A hash of the running executable, read once per process.
+fn build_identity() -> u64 {
+    static IDENTITY: OnceLock<u64> = OnceLock::new();
+    *IDENTITY.get_or_init(|| {
+        let mut hasher = DefaultHasher::new();
+        std::env::current_exe().and_then(fs::read).ok().hash(&mut hasher);
+        hasher.finish()
+    })
+}
+
+/// Every file the render reads besides the case: OBJ meshes and the cube map's PNG faces.
+fn assets(case: &Case) -> Vec<PathBuf> {
+    fn meshes(objects: &[ObjectSpec], out: &mut Vec<PathBuf>) {
+        for object in objects {
+            match &object.shape {
+                ShapeSpec::Mesh { obj } => out.push(obj.clone()),
+                ShapeSpec::Group { objects } => meshes(objects, out),
+                ShapeSpec::Sphere { .. } | ShapeSpec::Plane { .. } | ShapeSpec::Triangle { .. } => {}
+            }
+        }
+    }
+    let mut files = Vec::new();
+    meshes(&case.objects, &mut files);
+    if let Some(dir) = &case.background.cube_map
+        && let Ok(entries) = fs::read_dir(dir)
+    {
+        let mut faces: Vec<PathBuf> = entries
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|x| x.eq_ignore_ascii_case("png")))
+            .collect();
+        faces.sort();
+        files.extend(faces);
+    }
+    files
+}

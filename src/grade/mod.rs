@@ -1,0 +1,212 @@
+//! `goldray grade`: scoring folders of student renders against golden images.
+//!
+//! A [rubric](rubric) names the files every submission must hold and, for each, the render it is
+//! compared with (a TOML case or a course scene with the course's flags), which picture of that
+//! render (colour, normals or depth), the pass and partial-credit limits, and the points. The
+//! golden renders are made once per run (or read from the cache), then every student folder is
+//! graded in parallel; the report is `grades.csv`, `grades.json`, diff heatmaps and an HTML page
+//! per student under the report directory.
+//!
+//! ```no_run
+//! use goldray::grade::{GradeOptions, grade_class};
+//! # fn main() -> Result<(), goldray::grade::GradeError> {
+//! let options = GradeOptions { out: "report".into(), cache: None, show_progress: false };
+//! let report = grade_class("rubrics/mit6837.toml".as_ref(), "submissions".as_ref(), &options)?;
+//! for student in &report.students {
+//!     println!("{}: {} / {}", student.name, student.total, student.max_points);
+//! }
+//! # Ok(())
+//! # }
+//! ```
+
+mod error;
+mod golden;
+mod html;
+mod report;
+mod rubric;
+mod score;
+mod submission;
+
+use std::collections::BTreeMap;
+use std::fs;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use rayon::prelude::*;
+
+pub use error::GradeError;
+pub use golden::{GoldenRender, Goldens, prepare_goldens};
+pub use report::{ClassReport, RubricSummary};
+pub use rubric::{ImageSpec, Output, RenderSource, Rubric, Rule, load_rubric, parse_rubric};
+pub use score::{ImageResult, Outcome, StudentResult, Submission, grade_image, judge};
+
+/// `goldray grade`'s command line.
+#[derive(Clone, Debug, clap::Args)]
+pub struct GradeArgs {
+    /// The rubric (TOML): expected files, their golden renders, limits and points.
+    #[arg(long)]
+    pub rubric: PathBuf,
+    /// A folder holding one folder per student.
+    pub submissions: PathBuf,
+    /// Where to write grades.csv, grades.json and index.html (with the pictures).
+    #[arg(long, default_value = "grade-report")]
+    pub out: PathBuf,
+    /// Worker threads (default: one per core).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub jobs: Option<u32>,
+    /// Golden image cache (default: OUT/cache); share one between reports to render once.
+    #[arg(long)]
+    pub cache: Option<PathBuf>,
+    /// No progress bar and no summary.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// Where the report goes and how grading talks to the terminal.
+#[derive(Clone, Debug)]
+pub struct GradeOptions {
+    pub out: PathBuf,
+    /// `None`: `out/cache`.
+    pub cache: Option<PathBuf>,
+    /// Progress bars on standard error (they stay hidden when it is not a terminal).
+    pub show_progress: bool,
+}
+
+/// Runs `goldray grade` and prints its summary. Returns an error only when grading could not run;
+/// what students handed in never makes it fail.
+pub fn run_grade(args: &GradeArgs) -> Result<ClassReport, GradeError> {
+    let mut pool = rayon::ThreadPoolBuilder::new();
+    if let Some(jobs) = args.jobs {
+        pool = pool.num_threads(jobs as usize);
+    }
+    let options = GradeOptions {
+        out: args.out.clone(),
+        cache: args.cache.clone(),
+        show_progress: !args.quiet,
+    };
+    let report = pool
+        .build()?
+        .install(|| grade_class(&args.rubric, &args.submissions, &options))?;
+    if !args.quiet {
+        println!("{}", summary(&report, &args.out));
+    }
+    Ok(report)
+}
+
+/// Loads the rubric, prepares the goldens, grades every student folder of `submissions` on the
+/// current rayon pool and writes the whole report.
+pub fn grade_class(rubric_path: &Path, submissions: &Path, options: &GradeOptions) -> Result<ClassReport, GradeError> {
+    let rubric = load_rubric(rubric_path)?;
+    let out = &options.out;
+    let cache = options.cache.clone().unwrap_or_else(|| out.join("cache"));
+    let (folders, ignored) = student_folders(submissions, &[out, &cache])?;
+    let goldens = prepare_goldens(&rubric, &cache, out, options.show_progress)?;
+
+    let names: Vec<String> = folders.keys().cloned().collect();
+    let folders: Vec<Submission> = folders
+        .into_iter()
+        .zip(report::slugs(&names))
+        .collect::<Vec<_>>()
+        .into_par_iter()
+        .map(|((name, path), slug)| Submission::new(name, path, slug))
+        .collect();
+    // One task per image rather than per student, so that both cores stay busy to the end of a
+    // small class.
+    let per_student = rubric.images.len();
+    let bar = progress_bar((folders.len() * per_student) as u64, options.show_progress);
+    let results = (0..folders.len() * per_student)
+        .into_par_iter()
+        .map(|task| {
+            let (student, image) = (task / per_student, task % per_student);
+            let result = grade_image(&rubric.images[image], &goldens.images[image], &folders[student], out);
+            bar.inc(1);
+            result
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    bar.finish_and_clear();
+    let mut results = results.into_iter();
+    let students = folders
+        .iter()
+        .map(|submission| StudentResult::new(submission, results.by_ref().take(per_student).collect()))
+        .collect();
+
+    let report = ClassReport {
+        goldray: env!("CARGO_PKG_VERSION"),
+        rubric: RubricSummary::of(&rubric),
+        submissions: submissions.to_path_buf(),
+        goldens: goldens.renders,
+        ignored,
+        students,
+    };
+    report::write_data(&report, out)?;
+    html::write_html(&report, out)?;
+    Ok(report)
+}
+
+/// Student folders by name, and the names of the other entries. Hidden entries and `__MACOSX` are
+/// skipped silently, and so are the report and cache directories when they sit inside
+/// `submissions` (so that grading twice does not grade the first report).
+fn student_folders(
+    submissions: &Path,
+    own: &[&PathBuf],
+) -> Result<(BTreeMap<String, PathBuf>, Vec<String>), GradeError> {
+    let error = |source| GradeError::Submissions {
+        path: submissions.to_path_buf(),
+        source,
+    };
+    let own: Vec<PathBuf> = own.iter().filter_map(|p| p.canonicalize().ok()).collect();
+    let mut folders = BTreeMap::new();
+    let mut ignored = Vec::new();
+    for entry in fs::read_dir(submissions).map_err(error)? {
+        let entry = entry.map_err(error)?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let path = entry.path();
+        if name.starts_with('.') || name == "__MACOSX" || path.canonicalize().is_ok_and(|p| own.contains(&p)) {
+            continue;
+        }
+        if path.is_dir() {
+            folders.insert(name, path);
+        } else {
+            ignored.push(name);
+        }
+    }
+    ignored.sort();
+    Ok((folders, ignored))
+}
+
+fn progress_bar(total: u64, show: bool) -> ProgressBar {
+    let target = if show && std::io::stderr().is_terminal() {
+        ProgressDrawTarget::stderr()
+    } else {
+        ProgressDrawTarget::hidden()
+    };
+    let bar = ProgressBar::with_draw_target(Some(total), target);
+    if let Ok(style) = ProgressStyle::with_template("grading [{bar:40}] {pos}/{len} images {elapsed} (eta {eta})") {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar
+}
+
+/// What the TA reads on the terminal: how many of each verdict, and where the report is.
+fn summary(report: &ClassReport, out: &Path) -> String {
+    let mut counts: BTreeMap<&str, usize> = BTreeMap::new();
+    for result in report.students.iter().flat_map(|s| &s.images) {
+        *counts.entry(result.outcome.word()).or_default() += 1;
+    }
+    let counts: Vec<String> = counts.iter().map(|(word, n)| format!("{n} {word}")).collect();
+    let rendered = report.goldens.iter().filter(|g| !g.cached).count();
+    format!(
+        "graded {} students on {} images ({}); {} golden renders ({rendered} rendered, {} cached)\nreport: {}",
+        report.students.len(),
+        report.rubric.images.len(),
+        if counts.is_empty() {
+            "nothing graded".to_owned()
+        } else {
+            counts.join(", ")
+        },
+        report.goldens.len(),
+        report.goldens.len() - rendered,
+        out.join("index.html").display()
+    )
+}

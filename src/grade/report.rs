@@ -1,0 +1,160 @@
+//! The class report and its machine-readable forms: `grades.csv` for the spreadsheet the grades
+//! end up in, `grades.json` with everything for scripts.
+
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+
+use super::golden::GoldenRender;
+use super::rubric::{ImageSpec, Rubric};
+use super::score::StudentResult;
+use crate::film::{OutputError, write_file_atomic};
+
+/// Everything one grading run found; `grades.json` is this, serialised.
+#[derive(Clone, Debug, Serialize)]
+pub struct ClassReport {
+    /// goldray's version, which (with the build) the golden images depend on.
+    pub goldray: &'static str,
+    pub rubric: RubricSummary,
+    pub submissions: PathBuf,
+    pub goldens: Vec<GoldenRender>,
+    /// Entries of the submissions folder that are not student folders (loose files), by name.
+    pub ignored: Vec<String>,
+    /// By folder name.
+    pub students: Vec<StudentResult>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct RubricSummary {
+    pub path: PathBuf,
+    pub title: String,
+    pub max_points: f64,
+    pub images: Vec<ImageSpec>,
+}
+
+impl RubricSummary {
+    pub fn of(rubric: &Rubric) -> RubricSummary {
+        RubricSummary {
+            path: rubric.path.clone(),
+            title: rubric.title.clone(),
+            max_points: rubric.images.iter().map(|i| i.points).sum(),
+            images: rubric.images.clone(),
+        }
+    }
+}
+
+/// Writes `grades.csv` and `grades.json` into `out`.
+pub fn write_data(report: &ClassReport, out: &Path) -> Result<(), OutputError> {
+    write_file_atomic(&out.join("grades.csv"), grades_csv(report).as_bytes())?;
+    // Serialising plain data to a string cannot fail; infinite numbers (the PSNR of identical
+    // pictures) become null.
+    let json = serde_json::to_string_pretty(report).unwrap_or_else(|e| format!("{{\"error\": {:?}}}", e.to_string()));
+    write_file_atomic(&out.join("grades.json"), (json + "\n").as_bytes())
+}
+
+/// One row per student: the folder name, the points of each image in rubric order, the total.
+pub fn grades_csv(report: &ClassReport) -> String {
+    let mut csv = String::new();
+    let header = std::iter::once("student")
+        .chain(report.rubric.images.iter().map(|i| i.file.as_str()))
+        .chain(["total"])
+        .map(csv_field)
+        .collect::<Vec<_>>();
+    csv.push_str(&header.join(","));
+    csv.push_str("\r\n");
+    for student in &report.students {
+        let row = std::iter::once(csv_field(&student.name))
+            .chain(student.images.iter().map(|i| format_points(i.points)))
+            .chain([format_points(student.total)])
+            .collect::<Vec<_>>();
+        csv.push_str(&row.join(","));
+        csv.push_str("\r\n");
+    }
+    csv
+}
+
+/// RFC 4180 quoting, and a leading `'` on anything a spreadsheet would run as a formula: folder
+/// names are chosen by students, and `=HYPERLINK(…)` in a gradebook is an attack.
+fn csv_field(text: &str) -> String {
+    let guarded = if text.starts_with(['=', '+', '-', '@', '\t', '\r']) {
+        format!("'{text}")
+    } else {
+        text.to_owned()
+    };
+    if guarded.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", guarded.replace('"', "\"\""))
+    } else {
+        guarded
+    }
+}
+
+/// Points as a person writes them: `2`, `0.5`, `1.33`.
+pub fn format_points(points: f64) -> String {
+    let text = format!("{points:.2}");
+    text.trim_end_matches('0').trim_end_matches('.').to_owned()
+}
+
+/// A distinct file-system and URL-safe name per student folder: ASCII letters, digits, `-` and
+/// `_` kept, anything else `_`, and `-2`, `-3`… on a clash. Clashes are found ignoring case, for
+/// case-insensitive file systems.
+pub fn slugs(names: &[String]) -> Vec<String> {
+    let mut taken = HashSet::new();
+    names
+        .iter()
+        .map(|name| {
+            let mut base: String = name
+                .chars()
+                .take(60)
+                .map(|c| {
+                    if c.is_ascii_alphanumeric() || c == '-' || c == '_' {
+                        c
+                    } else {
+                        '_'
+                    }
+                })
+                .collect();
+            if base.is_empty() {
+                base = "student".to_owned();
+            }
+            let mut slug = base.clone();
+            let mut n = 1;
+            while !taken.insert(slug.to_ascii_lowercase()) {
+                n += 1;
+                slug = format!("{base}-{n}");
+            }
+            slug
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn csv_fields_are_quoted_and_formulas_defused() {
+        assert_eq!(csv_field("alice"), "alice");
+        assert_eq!(csv_field("a,b"), "\"a,b\"");
+        assert_eq!(csv_field("say \"hi\""), "\"say \"\"hi\"\"\"");
+        assert_eq!(csv_field("=1+1"), "'=1+1");
+        assert_eq!(csv_field("-x,y"), "\"'-x,y\"");
+    }
+
+    #[test]
+    fn points_drop_needless_decimals() {
+        assert_eq!(format_points(2.0), "2");
+        assert_eq!(format_points(0.5), "0.5");
+        assert_eq!(format_points(4.0 / 3.0), "1.33");
+        assert_eq!(format_points(0.0), "0");
+    }
+
+    #[test]
+    fn slugs_are_safe_and_distinct() {
+        let names = ["alice", "Alice", "<b>bob</b>", "", "..", "alice"].map(String::from);
+        assert_eq!(
+            slugs(&names),
+            ["alice", "Alice-2", "_b_bob__b_", "student", "__", "alice-3"]
+        );
+    }
+}

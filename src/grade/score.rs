@@ -1,0 +1,354 @@
+//! Grading one student: every expected file gets an [`Outcome`], points, the sentence that
+//! explains them, and the measurements behind them.
+
+use std::path::{Path, PathBuf};
+
+use serde::Serialize;
+
+use super::golden::GOLDEN_DIR;
+use super::rubric::{ImageSpec, Rule};
+use super::submission::{Folder, read_png};
+use crate::case::Tolerance;
+use crate::compare::{Image, Metrics, compare, diff_heatmap};
+use crate::film::{OutputError, encode_png, write_file_atomic, write_png};
+
+/// The verdict on one expected file. Only the first three come from a comparison; the others say
+/// why there was nothing to compare, and score nothing.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "verdict", rename_all = "snake_case")]
+pub enum Outcome {
+    /// Within the rule's pass limits: full points.
+    Pass,
+    /// Within the partial limits only: `partial_credit × points`.
+    Partial,
+    /// Beyond the partial limits: no points.
+    Fail,
+    /// No such file in the student's folder.
+    Missing,
+    /// A readable PNG of another size than the golden image.
+    WrongSize { expected: [u32; 2], actual: [u32; 2] },
+    /// Not a PNG: an EXR, a JPEG, a text file…
+    WrongFormat { found: String },
+    /// Refused before decoding: a huge file, or a PNG declaring a huge picture.
+    TooLarge { reason: String },
+    /// A PNG that cannot be decoded (truncated, corrupt), or a file that cannot be read.
+    Unreadable { reason: String },
+}
+
+impl Outcome {
+    pub fn word(&self) -> &'static str {
+        match self {
+            Outcome::Pass => "pass",
+            Outcome::Partial => "partial",
+            Outcome::Fail => "fail",
+            Outcome::Missing => "missing",
+            Outcome::WrongSize { .. } => "wrong size",
+            Outcome::WrongFormat { .. } => "wrong format",
+            Outcome::TooLarge { .. } => "too large",
+            Outcome::Unreadable { .. } => "unreadable",
+        }
+    }
+}
+
+/// One expected file of one student.
+#[derive(Clone, Debug, Serialize)]
+pub struct ImageResult {
+    pub file: String,
+    #[serde(flatten)]
+    pub outcome: Outcome,
+    pub points: f64,
+    pub max_points: f64,
+    /// Why these points, in one sentence naming the limits that decided.
+    pub explanation: String,
+    /// Conversions and where the file was found, when not exactly as expected.
+    pub notes: Vec<String>,
+    /// The student's file that was graded.
+    pub graded_file: Option<PathBuf>,
+    /// The student's picture as compared (8-bit RGB), relative to the report directory.
+    pub student_image: Option<String>,
+    /// The diff heatmap, relative to the report directory.
+    pub diff_image: Option<String>,
+    pub metrics: Option<Metrics>,
+}
+
+/// All of one student's results, in rubric order.
+#[derive(Clone, Debug, Serialize)]
+pub struct StudentResult {
+    /// The folder's name (lossily decoded if it is not UTF-8).
+    pub name: String,
+    pub folder: PathBuf,
+    /// The student's page, relative to the report directory.
+    pub page: String,
+    pub total: f64,
+    pub max_points: f64,
+    pub images: Vec<ImageResult>,
+}
+
+/// One student's folder, listed once, with the file-system and URL-safe name its pictures and
+/// page go under (see `report::slugs`).
+pub struct Submission {
+    pub name: String,
+    pub path: PathBuf,
+    pub slug: String,
+    files: Folder,
+}
+
+impl Submission {
+    pub fn new(name: String, path: PathBuf, slug: String) -> Submission {
+        let files = Folder::scan(&path);
+        Submission {
+            name,
+            path,
+            slug,
+            files,
+        }
+    }
+
+    /// Where the student's pictures go, relative to the report directory.
+    fn dir(&self) -> String {
+        format!("students/{}", self.slug)
+    }
+}
+
+impl StudentResult {
+    /// `images` in rubric order.
+    pub fn new(submission: &Submission, images: Vec<ImageResult>) -> StudentResult {
+        StudentResult {
+            name: submission.name.clone(),
+            folder: submission.path.clone(),
+            page: format!("{}.html", submission.dir()),
+            total: images.iter().map(|i| i.points).sum(),
+            max_points: images.iter().map(|i| i.max_points).sum(),
+            images,
+        }
+    }
+}
+
+/// Grades one expected image of one submission against its golden picture, writing the student's
+/// picture and the diff heatmap under `out` when they differ from the golden. Whatever the file,
+/// the result is a verdict; only a failure to write the report is an error.
+pub fn grade_image(
+    spec: &ImageSpec,
+    golden: &Image,
+    submission: &Submission,
+    out: &Path,
+) -> Result<ImageResult, OutputError> {
+    let (folder, dir) = (&submission.files, submission.dir());
+    let mut result = ImageResult {
+        file: spec.file.clone(),
+        outcome: Outcome::Missing,
+        points: 0.0,
+        max_points: spec.points,
+        explanation: String::new(),
+        notes: Vec::new(),
+        graded_file: None,
+        student_image: None,
+        diff_image: None,
+        metrics: None,
+    };
+    let located = match (&folder.error, folder.find(&spec.file)) {
+        (Some(reason), _) => return Ok(refused(result, Outcome::Unreadable { reason: reason.clone() })),
+        (None, None) => return Ok(refused(result, Outcome::Missing)),
+        (None, Some(located)) => located,
+    };
+    result.notes.extend(located.note);
+    result.graded_file = Some(located.path.clone());
+    let submitted = match read_png(&located.path) {
+        Ok(submitted) => submitted,
+        Err(outcome) => return Ok(refused(result, outcome)),
+    };
+    result.notes.extend(submitted.notes);
+
+    let copy = format!("{dir}/{}", spec.file);
+    let actual = Image::from_rgb8(submitted.picture, located.path);
+    let tolerance = Tolerance {
+        pixel: spec.rule.threshold,
+        fail_fraction: spec.rule.pass_fraction,
+        rmse: f64::INFINITY,
+        max: None,
+    };
+    let Some(metrics) = compare(golden, &actual, &tolerance).metrics else {
+        // Both pictures are 8-bit RGB, so only their sizes can keep them from being compared.
+        write_file_atomic(&out.join(&copy), &encode_png(&actual.preview)?)?;
+        result.student_image = Some(copy);
+        let outcome = Outcome::WrongSize {
+            expected: [golden.width, golden.height],
+            actual: [actual.width, actual.height],
+        };
+        return Ok(refused(result, outcome));
+    };
+    if metrics.worst.is_none() {
+        // Identical: the golden picture stands in for the student's, and there is no difference
+        // to draw, which keeps the report of a good class small.
+        result.student_image = Some(format!("{GOLDEN_DIR}/{}", spec.file));
+    } else {
+        write_file_atomic(&out.join(&copy), &encode_png(&actual.preview)?)?;
+        result.student_image = Some(copy);
+        if let Some(heatmap) = diff_heatmap(golden, &actual, spec.rule.threshold) {
+            let stem = spec.file.strip_suffix(".png").unwrap_or(&spec.file);
+            let diff = format!("{dir}/{stem}.diff.png");
+            write_png(&out.join(&diff), &heatmap)?;
+            result.diff_image = Some(diff);
+        }
+    }
+    let (outcome, explanation) = judge(&spec.rule, &metrics);
+    result.points = match outcome {
+        Outcome::Pass => spec.points,
+        Outcome::Partial => spec.points * spec.rule.partial_credit,
+        _ => 0.0,
+    };
+    result.outcome = outcome;
+    result.explanation = explanation;
+    result.metrics = Some(metrics);
+    Ok(result)
+}
+
+/// A result with nothing compared: no points, and the outcome's reason as the explanation.
+fn refused(mut result: ImageResult, outcome: Outcome) -> ImageResult {
+    result.explanation = match &outcome {
+        Outcome::Missing => format!("no {} in the folder", result.file),
+        Outcome::WrongSize { expected, actual } => format!(
+            "the picture is {}×{} pixels; the golden image is {}×{}",
+            actual[0], actual[1], expected[0], expected[1]
+        ),
+        Outcome::WrongFormat { found } => format!("the file is {found}, not a PNG"),
+        Outcome::TooLarge { reason } | Outcome::Unreadable { reason } => reason.clone(),
+        Outcome::Pass | Outcome::Partial | Outcome::Fail => String::new(),
+    };
+    result.outcome = outcome;
+    result.points = 0.0;
+    result
+}
+
+/// The rule applied to a comparison's measurements, with the sentence a student reads: what was
+/// measured, the limits of the grade it got, and the limit it broke when it lost points.
+pub fn judge(rule: &Rule, metrics: &Metrics) -> (Outcome, String) {
+    let within = |fraction: f64, flip: Option<f64>| {
+        metrics.failing_fraction <= fraction && flip.is_none_or(|limit| metrics.flip <= limit)
+    };
+    let measured = format!(
+        "{} of pixels differ by more than {} codes{}",
+        percent(metrics.failing_fraction),
+        rule.threshold,
+        rule.pass_flip
+            .map_or(String::new(), |_| format!(", FLIP mean {:.4}", metrics.flip)),
+    );
+    let limits = |fraction: f64, flip: Option<f64>| {
+        let flip = flip.map_or(String::new(), |limit| format!(" and FLIP ≤ {limit}"));
+        format!("≤ {}{flip}", percent(fraction))
+    };
+    let pass = limits(rule.pass_fraction, rule.pass_flip);
+    let partial = limits(rule.partial_fraction, rule.partial_flip);
+    if within(rule.pass_fraction, rule.pass_flip) {
+        (Outcome::Pass, format!("{measured}: within the pass limits ({pass})"))
+    } else if within(rule.partial_fraction, rule.partial_flip) {
+        let credit = rule.partial_credit * 100.0;
+        (
+            Outcome::Partial,
+            format!(
+                "{measured}: over the pass limits ({pass}), within the partial limits ({partial}): {credit}% of the points"
+            ),
+        )
+    } else {
+        (
+            Outcome::Fail,
+            format!("{measured}: over the partial limits ({partial})"),
+        )
+    }
+}
+
+/// A fraction as a short percentage: "0.5%", "12.34%", "0%", "<0.01%" (so that a handful of
+/// pixels never reads as none).
+pub fn percent(fraction: f64) -> String {
+    if fraction > 0.0 && fraction < 0.0001 {
+        return "<0.01%".to_owned();
+    }
+    let text = format!("{:.2}", fraction * 100.0);
+    let text = text.trim_end_matches('0').trim_end_matches('.');
+    format!("{text}%")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::compare::Encoding;
+
+    const RULE: Rule = Rule {
+        threshold: 8.0,
+        pass_fraction: 0.01,
+        partial_fraction: 0.05,
+        pass_flip: Some(0.1),
+        partial_flip: Some(0.2),
+        partial_credit: 0.5,
+    };
+
+    fn measured(failing_fraction: f64, flip: f64) -> Metrics {
+        Metrics {
+            encoding: Encoding::Code8,
+            pixels: 10_000,
+            pixel_threshold: 8.0,
+            failing_pixels: (failing_fraction * 10_000.0) as usize,
+            failing_fraction,
+            mae: 0.0,
+            rmse: 0.0,
+            psnr: f64::INFINITY,
+            flip,
+            worst: None,
+            channels: Vec::new(),
+            non_finite: None,
+        }
+    }
+
+    fn verdict(rule: &Rule, fraction: f64, flip: f64) -> Outcome {
+        judge(rule, &measured(fraction, flip)).0
+    }
+
+    #[test]
+    fn limits_are_inclusive_and_both_must_hold() {
+        assert_eq!(verdict(&RULE, 0.01, 0.1), Outcome::Pass);
+        assert_eq!(verdict(&RULE, 0.0101, 0.0), Outcome::Partial);
+        assert_eq!(
+            verdict(&RULE, 0.0, 0.11),
+            Outcome::Partial,
+            "FLIP alone can cost the pass"
+        );
+        assert_eq!(verdict(&RULE, 0.05, 0.2), Outcome::Partial);
+        assert_eq!(verdict(&RULE, 0.051, 0.0), Outcome::Fail);
+        assert_eq!(verdict(&RULE, 0.0, 0.21), Outcome::Fail);
+    }
+
+    #[test]
+    fn without_flip_limits_flip_is_not_judged_or_quoted() {
+        let rule = Rule {
+            pass_flip: None,
+            partial_flip: None,
+            ..RULE
+        };
+        let (outcome, explanation) = judge(&rule, &measured(0.0, 0.9));
+        assert_eq!(outcome, Outcome::Pass);
+        assert!(!explanation.contains("FLIP"), "{explanation}");
+    }
+
+    #[test]
+    fn explanations_name_the_limit_that_decided() {
+        let (_, partial) = judge(&RULE, &measured(0.02, 0.0));
+        assert!(
+            partial.starts_with("2% of pixels differ by more than 8 codes"),
+            "{partial}"
+        );
+        assert!(
+            partial.contains("over the pass limits (≤ 1% and FLIP ≤ 0.1)") && partial.contains("50% of the points"),
+            "{partial}"
+        );
+        let (_, fail) = judge(&RULE, &measured(0.5, 0.0));
+        assert!(fail.contains("over the partial limits (≤ 5% and FLIP ≤ 0.2)"), "{fail}");
+    }
+
+    #[test]
+    fn percentages_are_short_and_never_round_to_nothing() {
+        assert_eq!(percent(0.0), "0%");
+        assert_eq!(percent(0.0144), "1.44%");
+        assert_eq!(percent(0.5), "50%");
+        assert_eq!(percent(1.0 / 640_000.0), "<0.01%");
+    }
+}

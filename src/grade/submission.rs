@@ -1,0 +1,308 @@
+//! Reading what a student handed in, without trusting any of it.
+//!
+//! Files are opened read-only and never written. Every way a file can be wrong becomes an
+//! [`Outcome`] for the report instead of an error: nothing a student submits can stop the batch,
+//! exhaust memory (sizes are checked before anything is decoded) or hang it (only regular files
+//! are opened, so a FIFO or `/dev/zero` named `a01.png` is refused, not read).
+//!
+//! PNGs that hold the right picture in another layout are accepted and converted, with a note:
+//! grey (copied to R, G and B), grey+alpha and RGBA (alpha ignored), 16-bit (rounded to 8 bits),
+//! palette and low bit depths (expanded). Students are graded on their pixels, not on how their
+//! PNG library chose to store them.
+
+use std::fs::{self, File};
+use std::io::{Cursor, Read};
+use std::path::{Path, PathBuf};
+
+use image::codecs::png::PngDecoder;
+use image::{ColorType, DynamicImage, ImageDecoder, ImageError, Limits, RgbImage};
+
+use super::score::Outcome;
+
+/// The largest file read at all: a 16-bit RGBA PNG of a 4096² image stored uncompressed is
+/// 128 MiB, far beyond any honest submission.
+const MAX_FILE_BYTES: u64 = 128 << 20;
+/// The largest picture decoded, on either side; a decompression bomb declares far more.
+const MAX_SIDE: u32 = 16384;
+/// The most memory one decoded picture may take (8192² RGBA at 8 bits), checked before decoding
+/// because the decoder allocates the whole picture up front.
+const MAX_DECODE_BYTES: u64 = 256 << 20;
+/// How deep into a student's folder files are looked for (archives often add a level or two).
+const MAX_DEPTH: usize = 3;
+
+const PNG_MAGIC: &[u8] = b"\x89PNG\r\n\x1a\n";
+
+/// The files of one student's folder, found once and then looked up per expected image.
+pub struct Folder {
+    root: PathBuf,
+    /// Relative paths, shallowest first, then by name, so that lookups are deterministic.
+    files: Vec<PathBuf>,
+    /// Why the folder itself could not be listed.
+    pub error: Option<String>,
+}
+
+/// A file to grade, and how it was found when not exactly where expected.
+pub struct Located {
+    pub path: PathBuf,
+    pub note: Option<String>,
+}
+
+impl Folder {
+    pub fn scan(root: &Path) -> Folder {
+        let mut folder = Folder {
+            root: root.to_path_buf(),
+            files: Vec::new(),
+            error: None,
+        };
+        if let Err(e) = fs::read_dir(root) {
+            folder.error = Some(format!("cannot list the folder: {e}"));
+            return folder;
+        }
+        folder.walk(Path::new(""), 0);
+        folder.files.sort_by(|a, b| {
+            a.components()
+                .count()
+                .cmp(&b.components().count())
+                .then_with(|| a.cmp(b))
+        });
+        folder
+    }
+
+    /// Symbolic links to directories are not followed, so a link loop cannot trap the walk;
+    /// hidden entries and macOS archive litter (`__MACOSX`) are skipped.
+    fn walk(&mut self, relative: &Path, depth: usize) {
+        let Ok(entries) = fs::read_dir(self.root.join(relative)) else {
+            return;
+        };
+        for entry in entries.flatten() {
+            let name = entry.file_name();
+            if name.to_string_lossy().starts_with('.') || name == "__MACOSX" {
+                continue;
+            }
+            let path = relative.join(&name);
+            match entry.file_type() {
+                Ok(kind) if kind.is_dir() => {
+                    if depth + 1 < MAX_DEPTH {
+                        self.walk(&path, depth + 1);
+                    }
+                }
+                Ok(_) => self.files.push(path),
+                Err(_) => {}
+            }
+        }
+    }
+
+    /// `name` at the top of the folder; failing that, the shallowest file of that name in any
+    /// case anywhere below, with a note saying where it was found.
+    pub fn find(&self, name: &str) -> Option<Located> {
+        let exact = Path::new(name);
+        if self.files.iter().any(|f| f == exact) {
+            return Some(Located {
+                path: self.root.join(name),
+                note: None,
+            });
+        }
+        let found = self.files.iter().find(|f| {
+            f.file_name()
+                .is_some_and(|n| n.to_string_lossy().eq_ignore_ascii_case(name))
+        })?;
+        Some(Located {
+            path: self.root.join(found),
+            note: Some(format!("expected {name}, graded {} instead", found.display())),
+        })
+    }
+}
+
+/// A decoded submission: 8-bit RGB plus what was done to get there.
+pub struct Submitted {
+    pub picture: RgbImage,
+    pub notes: Vec<String>,
+}
+
+/// Reads and decodes `path` as a PNG, whatever its size (the caller judges the size, and still
+/// wants a wrong-sized picture for the report).
+pub fn read_png(path: &Path) -> Result<Submitted, Outcome> {
+    let unreadable = |reason: String| Outcome::Unreadable { reason };
+    let meta = fs::metadata(path).map_err(|e| unreadable(format!("cannot read the file: {e}")))?;
+    if !meta.is_file() {
+        return Err(unreadable("not a regular file".to_owned()));
+    }
+    if meta.len() > MAX_FILE_BYTES {
+        return Err(Outcome::TooLarge {
+            reason: format!(
+                "the file is {} MiB; files over {} MiB are not read",
+                meta.len() >> 20,
+                MAX_FILE_BYTES >> 20
+            ),
+        });
+    }
+    let mut bytes = Vec::new();
+    File::open(path)
+        .and_then(|file| file.take(MAX_FILE_BYTES).read_to_end(&mut bytes))
+        .map_err(|e| unreadable(format!("cannot read the file: {e}")))?;
+    if bytes.is_empty() {
+        return Err(unreadable("the file is empty".to_owned()));
+    }
+    if !bytes.starts_with(PNG_MAGIC) {
+        return Err(Outcome::WrongFormat {
+            found: sniff(&bytes).to_owned(),
+        });
+    }
+    if let Some((width, height)) = declared_size(&bytes)
+        && (width > MAX_SIDE || height > MAX_SIDE)
+    {
+        return Err(Outcome::TooLarge {
+            reason: format!(
+                "the PNG declares {width}×{height} pixels (a decompression bomb?); nothing over \
+                 {MAX_SIDE} on a side is decoded"
+            ),
+        });
+    }
+    let (picture, notes) = decode(&bytes)?;
+    Ok(Submitted { picture, notes })
+}
+
+fn decode(bytes: &[u8]) -> Result<(RgbImage, Vec<String>), Outcome> {
+    let mut limits = Limits::default();
+    limits.max_image_width = Some(MAX_SIDE);
+    limits.max_image_height = Some(MAX_SIDE);
+    limits.max_alloc = Some(MAX_DECODE_BYTES);
+    let decoder = PngDecoder::with_limits(Cursor::new(bytes), limits).map_err(decode_failure)?;
+    if decoder.total_bytes() > MAX_DECODE_BYTES {
+        let (width, height) = decoder.dimensions();
+        return Err(Outcome::TooLarge {
+            reason: format!(
+                "the PNG declares {width}×{height} pixels of {:?}, {} MiB decoded (a decompression bomb?); \
+                 nothing over {} MiB is decoded",
+                decoder.color_type(),
+                decoder.total_bytes() >> 20,
+                MAX_DECODE_BYTES >> 20
+            ),
+        });
+    }
+    let color = decoder.color_type();
+    let decoded = DynamicImage::from_decoder(decoder).map_err(decode_failure)?;
+    let mut notes = Vec::new();
+    match color {
+        ColorType::Rgb8 | ColorType::Rgb16 => {}
+        ColorType::L8 | ColorType::L16 => notes.push("grey PNG: compared as RGB with equal channels".to_owned()),
+        ColorType::La8 | ColorType::La16 | ColorType::Rgba8 | ColorType::Rgba16 => {
+            let translucent = decoded.to_rgba8().pixels().filter(|p| p.0[3] != 255).count();
+            notes.push(match translucent {
+                0 => "PNG with alpha: alpha ignored (every pixel is opaque)".to_owned(),
+                n => format!(
+                    "PNG with alpha: alpha ignored ({n} pixels are not opaque; their colour is compared as stored)"
+                ),
+            });
+        }
+        other => notes.push(format!("{other:?} PNG: converted to 8-bit RGB")),
+    }
+    if color.bytes_per_pixel() / color.channel_count() == 2 {
+        notes.push("16-bit PNG: rounded to 8 bits per channel".to_owned());
+    }
+    Ok((decoded.into_rgb8(), notes))
+}
+
+/// The decoder's errors, sorted into what a TA needs to know.
+fn decode_failure(error: ImageError) -> Outcome {
+    match error {
+        ImageError::Limits(e) => Outcome::TooLarge {
+            reason: format!("decoding would exceed the memory limit: {e}"),
+        },
+        ImageError::IoError(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => Outcome::Unreadable {
+            reason: "truncated PNG: the file ends before the image data does".to_owned(),
+        },
+        other => Outcome::Unreadable {
+            reason: format!("corrupt PNG: {other}"),
+        },
+    }
+}
+
+/// Width and height from the IHDR chunk, which a valid PNG has right after its signature.
+fn declared_size(bytes: &[u8]) -> Option<(u32, u32)> {
+    let header = bytes.get(8..24)?;
+    if &header[4..8] != b"IHDR" {
+        return None;
+    }
+    let word = |at: usize| u32::from_be_bytes([header[at], header[at + 1], header[at + 2], header[at + 3]]);
+    Some((word(8), word(12)))
+}
+
+/// What a file that is not a PNG is, by its first bytes, so the verdict can say "a JPEG" rather
+/// than "unreadable".
+fn sniff(bytes: &[u8]) -> &'static str {
+    const SIGNATURES: &[(&[u8], &str)] = &[
+        (b"\x76\x2f\x31\x01", "an OpenEXR image"),
+        (b"\xff\xd8\xff", "a JPEG image"),
+        (b"GIF8", "a GIF image"),
+        (b"BM", "a BMP image"),
+        (b"P3", "a PPM image"),
+        (b"P6", "a PPM image"),
+        (b"II*\0", "a TIFF image"),
+        (b"MM\0*", "a TIFF image"),
+        (b"RIFF", "a RIFF file (WebP?)"),
+        (b"%PDF", "a PDF document"),
+        (b"PK\x03\x04", "a ZIP archive"),
+        (b"\x1f\x8b", "a gzip archive"),
+    ];
+    SIGNATURES
+        .iter()
+        .find(|(magic, _)| bytes.starts_with(magic))
+        .map_or("not an image (its first bytes match no known format)", |(_, what)| what)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn reason(outcome: Outcome) -> String {
+        match outcome {
+            Outcome::Unreadable { reason } | Outcome::TooLarge { reason } => reason,
+            Outcome::WrongFormat { found } => found,
+            other => panic!("unexpected {other:?}"),
+        }
+    }
+
+    #[test]
+    fn files_that_are_not_pngs_are_named_by_their_signature() {
+        assert_eq!(sniff(b"\x76\x2f\x31\x01rest"), "an OpenEXR image");
+        assert_eq!(sniff(b"\xff\xd8\xff\xe0"), "a JPEG image");
+        assert_eq!(sniff(b"P6\n100 100\n255\n"), "a PPM image");
+        assert!(sniff(b"hello").starts_with("not an image"));
+    }
+
+    #[test]
+    fn the_declared_size_comes_from_the_header_alone() {
+        let mut bytes = PNG_MAGIC.to_vec();
+        bytes.extend([0, 0, 0, 13]);
+        bytes.extend(b"IHDR");
+        bytes.extend(800u32.to_be_bytes());
+        bytes.extend(600u32.to_be_bytes());
+        assert_eq!(declared_size(&bytes), Some((800, 600)));
+        assert_eq!(declared_size(&bytes[..20]), None);
+    }
+
+    #[test]
+    fn directories_empty_and_absent_files_are_verdicts() {
+        let dir = tempfile::tempdir().unwrap();
+        let empty = dir.path().join("empty.png");
+        fs::write(&empty, b"").unwrap();
+        assert!(reason(read_png(dir.path()).err().unwrap()).contains("not a regular file"));
+        assert!(reason(read_png(&empty).err().unwrap()).contains("empty"));
+        assert!(reason(read_png(&dir.path().join("absent.png")).err().unwrap()).contains("cannot read"));
+    }
+
+    #[test]
+    fn a_file_is_found_nested_and_in_another_case_with_a_note() {
+        let dir = tempfile::tempdir().unwrap();
+        fs::create_dir_all(dir.path().join("hw4/out")).unwrap();
+        fs::write(dir.path().join("hw4/out/A01.PNG"), b"x").unwrap();
+        fs::write(dir.path().join("a02.png"), b"x").unwrap();
+        let folder = Folder::scan(dir.path());
+        assert!(folder.find("a02.png").is_some_and(|found| found.note.is_none()));
+        let nested = folder.find("a01.png").unwrap();
+        assert_eq!(nested.path, dir.path().join("hw4/out/A01.PNG"));
+        assert!(nested.note.unwrap().contains("hw4/out/A01.PNG"));
+        assert!(folder.find("a03.png").is_none());
+    }
+}

@@ -1,0 +1,328 @@
+//! `goldray grade` end to end: a synthetic class made from goldray's own renders (a perfect
+//! student, missing shadows, a shifted camera, gamma applied, missing, corrupt, wrong-sized,
+//! converted and hostile files) graded against a small rubric; the verdicts and points, the CSV
+//! read back, the HTML report opened in headless Chromium, the golden cache, the command line and
+//! the shipped course rubric.
+
+#[path = "grade/chromium.rs"]
+mod chromium;
+#[path = "grade/class.rs"]
+mod class;
+#[path = "grade/cli.rs"]
+mod cli;
+#[path = "grade/rubrics.rs"]
+mod rubrics;
+
+use std::collections::BTreeMap;
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+use std::time::Instant;
+
+use goldray::grade::{ClassReport, GradeOptions, Outcome, StudentResult, grade_class};
+
+use class::{Class, FILES, HOSTILE, POINTS, make_class_at};
+
+/// The class graded once and shared by the tests that only read the report. It lives in
+/// `target/tmp/grade-class/` (replaced by each run), so that the report can be opened after the
+/// tests: `target/tmp/grade-class/report/index.html`.
+struct Graded {
+    class: Class,
+    out: PathBuf,
+    report: ClassReport,
+    seconds: f64,
+}
+
+fn graded() -> &'static Graded {
+    static GRADED: OnceLock<Graded> = OnceLock::new();
+    GRADED.get_or_init(|| {
+        let class = make_class_at(&Path::new(env!("CARGO_TARGET_TMPDIR")).join("grade-class"));
+        let out = class.dir.join("report");
+        let options = GradeOptions {
+            out: out.clone(),
+            cache: None,
+            show_progress: false,
+        };
+        let started = Instant::now();
+        let report = grade_class(&class.rubric, &class.submissions, &options).unwrap_or_else(|e| panic!("{e}"));
+        let seconds = started.elapsed().as_secs_f64();
+        Graded {
+            class,
+            out,
+            report,
+            seconds,
+        }
+    })
+}
+
+fn student<'a>(report: &'a ClassReport, name: &str) -> &'a StudentResult {
+    report
+        .students
+        .iter()
+        .find(|s| s.name == name)
+        .unwrap_or_else(|| panic!("no student {name}"))
+}
+
+/// The verdict words of a student's three images, in rubric order.
+fn verdicts(report: &ClassReport, name: &str) -> Vec<&'static str> {
+    student(report, name).images.iter().map(|i| i.outcome.word()).collect()
+}
+
+#[test]
+fn every_student_gets_the_verdicts_and_points_their_files_deserve() {
+    let Graded { report, seconds, .. } = graded();
+    let expect = [
+        ("perfect", ["pass", "pass", "pass"], 4.0),
+        ("no_shadows", ["fail", "pass", "pass"], 2.0),
+        ("shifted_camera", ["fail", "fail", "fail"], 0.0),
+        ("gamma", ["fail", "pass", "pass"], 2.0),
+        ("missing_and_corrupt", ["missing", "unreadable", "unreadable"], 0.0),
+        ("wrong_sizes", ["wrong size", "wrong size", "wrong size"], 0.0),
+        ("formats", ["pass", "pass", "pass"], 4.0),
+        ("bad_files", ["wrong format", "too large", "too large"], 0.0),
+        ("scribbled", ["partial", "pass", "pass"], 3.0),
+        (HOSTILE, ["pass", "pass", "pass"], 4.0),
+    ];
+    let mut table = String::new();
+    for s in &report.students {
+        for i in &s.images {
+            table += &format!(
+                "{:>22} {:>12} {:>8} {:>5} {}\n",
+                s.name,
+                i.file,
+                i.outcome.word(),
+                i.points,
+                i.explanation
+            );
+        }
+    }
+    for (name, words, total) in expect {
+        assert_eq!(verdicts(report, name), words, "{name}:\n{table}");
+        assert_eq!(student(report, name).total, total, "{name}:\n{table}");
+        assert_eq!(student(report, name).max_points, 4.0);
+    }
+    assert_eq!(
+        report.students.len(),
+        expect.len(),
+        "one result per student folder, hidden folders skipped"
+    );
+    assert_eq!(report.ignored, ["README.txt"]);
+    println!("graded {} students in {seconds:.2} s\n{table}", report.students.len());
+}
+
+#[test]
+fn verdicts_carry_the_evidence_behind_them() {
+    let report = &graded().report;
+    let by = |name: &str, file: usize| &student(report, name).images[file];
+
+    let no_shadows = by("no_shadows", 0);
+    let metrics = no_shadows.metrics.as_ref().expect("a compared image has metrics");
+    assert!(metrics.failing_fraction > 0.05, "{metrics:?}");
+    assert!(metrics.worst.is_some() && metrics.rmse > 0.0 && metrics.flip > 0.0);
+    assert!(
+        no_shadows.explanation.contains("over the partial limits"),
+        "{}",
+        no_shadows.explanation
+    );
+    assert!(no_shadows.diff_image.is_some() && no_shadows.student_image.is_some());
+
+    let partial = by("scribbled", 0);
+    assert_eq!(partial.points, 1.0, "half of 2 points: {}", partial.explanation);
+    assert!(
+        partial.explanation.contains("50% of the points"),
+        "{}",
+        partial.explanation
+    );
+    assert_eq!(
+        by("scribbled", 1).outcome,
+        Outcome::Pass,
+        "a ±3-code wobble is under the 8-code threshold"
+    );
+
+    let perfect = by("perfect", 0);
+    assert_eq!(
+        perfect.student_image.as_deref(),
+        Some("golden/color.png"),
+        "an identical picture is not copied"
+    );
+    assert_eq!(perfect.diff_image, None);
+
+    assert_eq!(
+        by("wrong_sizes", 0).outcome,
+        Outcome::WrongSize {
+            expected: [100, 100],
+            actual: [120, 90]
+        }
+    );
+    assert!(
+        by("wrong_sizes", 0).student_image.is_some(),
+        "a wrong-sized picture is still shown"
+    );
+    assert!(
+        by("missing_and_corrupt", 1).explanation.contains("truncated"),
+        "{}",
+        by("missing_and_corrupt", 1).explanation
+    );
+    assert!(
+        by("missing_and_corrupt", 2).explanation.contains("corrupt"),
+        "{}",
+        by("missing_and_corrupt", 2).explanation
+    );
+    assert!(
+        by("bad_files", 0).explanation.contains("OpenEXR"),
+        "{}",
+        by("bad_files", 0).explanation
+    );
+    assert!(
+        by("bad_files", 1).explanation.contains("50000×50000"),
+        "{}",
+        by("bad_files", 1).explanation
+    );
+    assert!(
+        by("bad_files", 2).explanation.contains("MiB decoded"),
+        "{}",
+        by("bad_files", 2).explanation
+    );
+
+    let notes = |name: &str, file: usize| by(name, file).notes.join("; ");
+    assert!(notes("formats", 0).contains("alpha ignored"), "{}", notes("formats", 0));
+    assert!(notes("formats", 1).contains("16-bit"), "{}", notes("formats", 1));
+    assert!(notes("formats", 2).contains("grey"), "{}", notes("formats", 2));
+    assert!(
+        notes(HOSTILE, 0).contains("submission/COLOR.PNG"),
+        "{}",
+        notes(HOSTILE, 0)
+    );
+}
+
+#[test]
+fn grades_csv_parses_back_to_the_report() {
+    let Graded { out, report, .. } = graded();
+    let text = fs::read_to_string(out.join("grades.csv")).unwrap();
+    let rows = parse_csv(&text);
+    let header: Vec<&str> = rows[0].iter().map(String::as_str).collect();
+    assert_eq!(header, ["student", "color.png", "normals.png", "depth.png", "total"]);
+    assert_eq!(rows.len(), report.students.len() + 1, "one row per student");
+    let by_name: BTreeMap<&str, &Vec<String>> = rows[1..].iter().map(|r| (r[0].as_str(), r)).collect();
+    for s in &report.students {
+        let row = by_name
+            .get(s.name.as_str())
+            .unwrap_or_else(|| panic!("{} has no row:\n{text}", s.name));
+        let numbers: Vec<f64> = row[1..].iter().map(|v| v.parse().unwrap()).collect();
+        let points: Vec<f64> = s.images.iter().map(|i| i.points).collect();
+        assert_eq!(numbers[..3], points[..], "{}", s.name);
+        assert_eq!(numbers[3], s.total);
+        assert!(numbers[..3].iter().zip(POINTS).all(|(p, max)| *p <= max));
+    }
+    let json: serde_json::Value = serde_json::from_str(&fs::read_to_string(out.join("grades.json")).unwrap()).unwrap();
+    assert_eq!(json["students"].as_array().unwrap().len(), report.students.len());
+    assert_eq!(json["rubric"]["max_points"], 4.0);
+}
+
+/// RFC 4180: quoted fields may hold commas, doubled quotes and line breaks.
+fn parse_csv(text: &str) -> Vec<Vec<String>> {
+    let (mut rows, mut row, mut field) = (Vec::new(), Vec::new(), String::new());
+    let mut chars = text.chars().peekable();
+    let mut quoted = false;
+    while let Some(c) = chars.next() {
+        match (quoted, c) {
+            (true, '"') if chars.peek() == Some(&'"') => {
+                chars.next();
+                field.push('"');
+            }
+            (true, '"') => quoted = false,
+            (true, c) => field.push(c),
+            (false, '"') => quoted = true,
+            (false, ',') => row.push(std::mem::take(&mut field)),
+            (false, '\r') => {}
+            (false, '\n') => {
+                row.push(std::mem::take(&mut field));
+                rows.push(std::mem::take(&mut row));
+            }
+            (false, c) => field.push(c),
+        }
+    }
+    rows
+}
+
+#[test]
+fn student_files_are_never_modified() {
+    let Graded { class, .. } = graded();
+    for (path, bytes) in &class.files {
+        assert_eq!(&fs::read(path).unwrap(), bytes, "{} changed", path.display());
+    }
+    let mut count = 0;
+    let mut stack = vec![class.submissions.clone()];
+    while let Some(dir) = stack.pop() {
+        for entry in fs::read_dir(dir).unwrap().flatten() {
+            if entry.file_type().unwrap().is_dir() {
+                stack.push(entry.path());
+            } else {
+                count += 1;
+            }
+        }
+    }
+    assert_eq!(count, class.files.len(), "grading added no file to the submissions");
+}
+
+#[test]
+fn html_escapes_every_student_controlled_string() {
+    let Graded { out, report, .. } = graded();
+    let index = fs::read_to_string(out.join("index.html")).unwrap();
+    assert!(
+        !index.contains("<img src=x"),
+        "the folder name reached the HTML unescaped"
+    );
+    assert!(index.contains("&lt;img src=x onerror=alert(1)&gt; &amp; &quot;Mallory&quot;"));
+    let page = fs::read_to_string(out.join(&student(report, HOSTILE).page)).unwrap();
+    assert!(!page.contains("<img src=x") && page.contains("&lt;img src=x"));
+    let csv = fs::read_to_string(out.join("grades.csv")).unwrap();
+    assert!(
+        csv.contains("\"<img src=x onerror=alert(1)> & \"\"Mallory\"\"\""),
+        "{csv}"
+    );
+}
+
+#[test]
+fn the_report_opens_in_headless_chromium_with_its_table_and_pictures() {
+    let Graded { out, report, .. } = graded();
+    let dom = chromium::dump_dom(&out.join("index.html"));
+    let rows = dom.matches("<tr><td class=\"name\">").count();
+    assert_eq!(rows, report.students.len(), "one table row per student:\n{dom}");
+    assert!(
+        dom.contains(&format!("data-images-loaded=\"{}\"", FILES.len())),
+        "{dom}"
+    );
+    assert!(dom.contains("data-images-broken=\"0\""), "{dom}");
+
+    for name in ["no_shadows", "missing_and_corrupt", HOSTILE] {
+        let page = out.join(&student(report, name).page);
+        let dom = chromium::dump_dom(&page);
+        assert!(
+            dom.contains("data-images-broken=\"0\""),
+            "{name}: a picture did not load:\n{dom}"
+        );
+        let loaded = dom
+            .split("data-images-loaded=\"")
+            .nth(1)
+            .and_then(|s| s.split('"').next())
+            .unwrap_or("0");
+        assert!(
+            loaded.parse::<usize>().unwrap() >= FILES.len(),
+            "{name}: {loaded} pictures loaded"
+        );
+    }
+
+    let shot = chromium::screenshot(
+        &out.join(&student(report, "no_shadows").page),
+        1000,
+        800,
+        &out.join("shot.png"),
+    );
+    let colours: std::collections::HashSet<[u8; 3]> = shot.pixels().map(|p| p.0).collect();
+    assert!(
+        colours.len() > 500,
+        "the screenshot looks blank: {} colours",
+        colours.len()
+    );
+}
