@@ -47,11 +47,11 @@ fn lit(objects: &str) -> String {
 
 #[test]
 fn rays_parallel_to_a_plane_see_it_edge_on_as_nothing() {
-    let film = render(&format!(
+    let film = render(
         "[render]\nsize = [25, 25]\n[camera]\ncenter = [0, 1, 0]\ndirection = [1, 0, 0]\nup = [0, 1, 0]\nfov = 30\n\
          [background]\ncolor = [0.5, 0.5, 0.5]\nambient = [1, 1, 1]\n[materials.black]\ndiffuse = [0, 0, 0]\n\
-         [[object]]\nkind = \"plane\"\nnormal = [0, 1, 0]\noffset = 0\nmaterial = \"black\"\n"
-    ))
+         [[object]]\nkind = \"plane\"\nnormal = [0, 1, 0]\noffset = 0\nmaterial = \"black\"\n",
+    )
     .unwrap();
     assert_sensible(&film, "edge-on plane");
     let middle_row = film.index(12, 12);

@@ -45,7 +45,7 @@ fn scene(dir: &Path, at: Placement) -> RgbImage {
         })
         .collect();
     write_obj(&dir.join("blob.obj"), &placed, &triangles).unwrap();
-    let plane_offset: f64 = -1.0 * at.scale + at.offset[1];
+    let plane_offset: f64 = at.offset[1] - at.scale;
     let mut toml = String::new();
     writeln!(toml, "[render]\nsize = [100, 100]\nshadows = true\nbounces = 2\n").unwrap();
     writeln!(toml, "[camera]\ncenter = {}\ndirection = [0, -0.25, -1]\nup = [0, 1, 0]\nfov = 40\n", at.point([0.0, 1.0, 6.0])).unwrap();
