@@ -11,5 +11,6 @@ pub mod pipeline;
 pub mod real;
 pub mod render;
 pub mod scene;
+pub mod stats;
 
 pub use error::Error;
