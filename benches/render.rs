@@ -5,6 +5,10 @@
 //! - `end_to_end/*`: load, build and render shipped cases (no file writes).
 //! - `course_scenes/seven_at_800`: the course's seven grading commands at 800×800, one after
 //!   another, each parsed, rendered and its three PNGs encoded, as `goldray mit6837` does.
+//! - `stats_overhead/*`: the same render with and without ray counting (`--stats`), on one
+//!   thread, for `cases/bench/blob_1m.toml` (expensive rays: 1.3M triangles; the OBJ is generated
+//!   on first use) and `cases/mirrors.toml` (cheap rays, where counting weighs most). Criterion
+//!   reports rays/s; `on` and `off` should agree within noise.
 
 use std::path::Path;
 use std::sync::Arc;
@@ -12,14 +16,14 @@ use std::sync::Arc;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use goldray::case::{AssignmentOptions, LoadOptions, load, load_assignment_scene};
 use goldray::film::{Tonemap, color_image, depth_image, encode_png, normals_image};
-use goldray::geometry::generate::blob;
+use goldray::geometry::generate::{blob, write_obj};
 use goldray::geometry::mesh::{Mesh, VertexNormals};
-use goldray::pipeline::render_case;
+use goldray::pipeline::{render_case, render_options};
 use goldray::real::{Color, Vec3};
 use goldray::render::camera::Camera;
 use goldray::render::material::Material;
-use goldray::render::{Filter, Profile, Progress, RenderOptions, render};
-use goldray::scene::{Aggregate, Background, Object, Scene, Shape};
+use goldray::render::{Filter, Profile, Progress, RenderOptions, render, render_counting_rays};
+use goldray::scene::{Aggregate, Background, Object, Scene, Shape, build_scene};
 
 const SIDE: u32 = 256;
 
@@ -119,5 +123,37 @@ fn course_scenes(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, primary_rays, end_to_end, course_scenes);
+/// The 1.3M-triangle OBJ is 50 MB, so it is generated rather than committed; this is what
+/// `cargo run --release --example blob -- 8 1 cases/bench/assets/blob_1m.obj` writes.
+fn ensure_blob_1m(path: &Path) {
+    if !path.exists() {
+        let (positions, triangles) = blob(8, 1);
+        std::fs::create_dir_all(path.parent().expect("the asset has a directory")).expect("cases/bench/assets is writable");
+        write_obj(path, &positions, &triangles).expect("the blob OBJ is written");
+    }
+}
+
+fn stats_overhead(c: &mut Criterion) {
+    let cases = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases");
+    ensure_blob_1m(&cases.join("bench/assets/blob_1m.obj"));
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("a thread pool");
+    let mut group = c.benchmark_group("stats_overhead");
+    group.sample_size(10);
+    for path in [cases.join("bench/blob_1m.toml"), cases.join("mirrors.toml")] {
+        let case = load(&path, &LoadOptions::default()).expect("a shipped case loads");
+        let scene = build_scene(&case).expect("a shipped case builds");
+        let options = render_options(&case);
+        let (_, rays) = pool.install(|| render_counting_rays(&scene, &options, &Progress::hidden()));
+        group.throughput(Throughput::Elements(rays.total()));
+        group.bench_function(format!("{}/off", case.name), |b| {
+            b.iter(|| pool.install(|| render(&scene, &options, &Progress::hidden())))
+        });
+        group.bench_function(format!("{}/on", case.name), |b| {
+            b.iter(|| pool.install(|| render_counting_rays(&scene, &options, &Progress::hidden())))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, primary_rays, end_to_end, course_scenes, stats_overhead);
 criterion_main!(benches);

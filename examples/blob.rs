@@ -20,7 +20,10 @@ fn main() -> ExitCode {
         return ExitCode::from(2);
     };
     let (positions, triangles) = blob(subdivisions, seed);
-    if let Err(error) = write_obj(&out, &positions, &triangles) {
+    // The benchmark mesh goes to cases/bench/assets/, which git ignores and a fresh clone lacks.
+    let parent = out.parent().filter(|p| !p.as_os_str().is_empty());
+    let written = parent.map_or(Ok(()), std::fs::create_dir_all).and_then(|()| write_obj(&out, &positions, &triangles));
+    if let Err(error) = written {
         eprintln!("error: cannot write {}: {error}", out.display());
         return ExitCode::FAILURE;
     }

@@ -13,5 +13,6 @@ pub mod pipeline;
 pub mod real;
 pub mod render;
 pub mod scene;
+pub mod stats;
 
 pub use error::Error;

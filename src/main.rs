@@ -7,7 +7,7 @@ use clap::{Parser, Subcommand};
 
 use goldray::assignment_outputs::AssignmentOutputs;
 use goldray::case::{AssignmentOptions, LoadOptions, MAX_IMAGE_SIZE};
-use goldray::pipeline::{import_assignment, render_assignment, render_case_file};
+use goldray::pipeline::{Rendered, import_assignment, render_assignment, render_case_file};
 
 /// A deterministic Whitted ray tracer and scene-to-image regression harness.
 #[derive(Parser)]
@@ -113,6 +113,13 @@ struct RunFlags {
     /// Allow images larger than 16384 pixels on a side.
     #[arg(long)]
     force: bool,
+    /// After the render, print statistics to stderr: time per phase, BVH sizes, rays by kind
+    /// with Mrays/s, threads, peak memory.
+    #[arg(long)]
+    stats: bool,
+    /// Write the same statistics as JSON to FILE.
+    #[arg(long, value_name = "FILE")]
+    stats_json: Option<PathBuf>,
 }
 
 fn main() -> ExitCode {
@@ -154,9 +161,8 @@ fn run(cli: Cli) -> Result<ExitCode, String> {
     match cli.command {
         Command::Render { case, out, run } => {
             let load = LoadOptions { allow_huge_images: run.force };
-            let written = run.install(|| render_case_file(&case, &out, &load, !run.quiet))?;
-            run.report(&written);
-            Ok(ExitCode::SUCCESS)
+            let rendered = run.install(|| render_case_file(&case, &out, &load, !run.quiet))?;
+            run.report(&rendered).map(|()| ExitCode::SUCCESS)
         }
         Command::Mit6837 { input, output, normals, depth, exr, course, run } => {
             let depth = depth.map(|values| parse_depth(&values[..2]).map(|(min, max)| (min, max, PathBuf::from(&values[2])))).transpose()?;
@@ -171,9 +177,8 @@ fn run(cli: Cli) -> Result<ExitCode, String> {
             }
             let depth_range = depth.map(|(min, max, _)| (min, max));
             let options = course.options(depth_range, outputs.normals.is_some(), run.force)?;
-            let written = run.install(|| render_assignment(&input, &options, &outputs, !run.quiet))?;
-            run.report(&written);
-            Ok(ExitCode::SUCCESS)
+            let rendered = run.install(|| render_assignment(&input, &options, &outputs, !run.quiet))?;
+            run.report(&rendered).map(|()| ExitCode::SUCCESS)
         }
         Command::Import { scene, output, force, depth, normals, course } => {
             let depth_range = depth.map(|values| parse_depth(&values)).transpose()?;
@@ -244,11 +249,18 @@ impl RunFlags {
         pool.install(work).map_err(|e| e.to_string())
     }
 
-    fn report(&self, written: &[PathBuf]) {
+    fn report(&self, rendered: &Rendered) -> Result<(), String> {
         if !self.quiet {
-            for path in written {
+            for path in &rendered.written {
                 eprintln!("wrote {}", path.display());
             }
+        }
+        if self.stats {
+            eprint!("{}", rendered.stats);
+        }
+        match &self.stats_json {
+            Some(path) => rendered.stats.write_json(path).map_err(|e| e.to_string()),
+            None => Ok(()),
         }
     }
 }

@@ -1,19 +1,33 @@
 //! The whole path from a case file to files on disk, as the `render` command runs it.
 
 use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 use crate::assignment_outputs::AssignmentOutputs;
 use crate::case::{self, AssignmentOptions, Case, LoadOptions, case_to_toml, load_assignment_scene};
 use crate::error::Error;
 use crate::film::{Film, OutputOptions, write_outputs};
-use crate::render::{Progress, RenderOptions, render};
-use crate::scene::build_scene;
+use crate::render::{Progress, RenderOptions, render, render_counting_rays};
+use crate::scene::{build_scene, build_scene_measured};
+use crate::stats::{Phases, RenderStats};
+
+/// What a command wrote, and the statistics of the render behind it.
+#[derive(Debug)]
+pub struct Rendered {
+    pub written: Vec<PathBuf>,
+    pub stats: RenderStats,
+}
 
 /// Renders a loaded case to a film, showing progress when asked.
 pub fn render_case(case: &Case, show_progress: bool) -> Result<Film, Error> {
     let scene = build_scene(case)?;
+    Ok(render(&scene, &render_options(case), &progress(case, show_progress)))
+}
+
+/// The renderer's options from a case's `[render]` table.
+pub fn render_options(case: &Case) -> RenderOptions {
     let settings = &case.render;
-    let options = RenderOptions {
+    RenderOptions {
         width: settings.width,
         height: settings.height,
         bounces: settings.bounces,
@@ -21,9 +35,11 @@ pub fn render_case(case: &Case, show_progress: bool) -> Result<Film, Error> {
         samples: settings.samples,
         seed: settings.seed,
         filter: settings.filter,
-    };
-    let progress = Progress::new(u64::from(settings.height), &case.name, show_progress);
-    Ok(render(&scene, &options, &progress))
+    }
+}
+
+fn progress(case: &Case, show_progress: bool) -> Progress {
+    Progress::new(u64::from(case.render.height), &case.name, show_progress)
 }
 
 /// The files a case's render writes, as its options ask.
@@ -42,10 +58,12 @@ pub fn render_case_file(
     out_dir: &Path,
     load: &LoadOptions,
     show_progress: bool,
-) -> Result<Vec<PathBuf>, Error> {
-    let case = case::load(path, load)?;
-    let film = render_case(&case, show_progress)?;
-    Ok(write_outputs(out_dir, &case.name, &film, &output_options(&case))?)
+) -> Result<Rendered, Error> {
+    measured_run(
+        || Ok(case::load(path, load)?),
+        show_progress,
+        |case, film| Ok(write_outputs(out_dir, &case.name, film, &output_options(case))?),
+    )
 }
 
 /// `goldray mit6837`: renders a course scene file as the course binary would and writes the
@@ -55,10 +73,33 @@ pub fn render_assignment(
     options: &AssignmentOptions,
     outputs: &AssignmentOutputs,
     show_progress: bool,
-) -> Result<Vec<PathBuf>, Error> {
-    let case = load_assignment_scene(scene, options)?;
-    let film = render_case(&case, show_progress)?;
-    Ok(outputs.write(&film)?)
+) -> Result<Rendered, Error> {
+    measured_run(|| Ok(load_assignment_scene(scene, options)?), show_progress, |_, film| Ok(outputs.write(film)?))
+}
+
+/// Load, build, render and write, timing each phase and counting rays. The commands always
+/// measure: counting costs nothing measurable (`cargo bench -- stats_overhead`), so `--stats`
+/// only decides whether the numbers are shown, and can never change what is rendered.
+fn measured_run(
+    load: impl FnOnce() -> Result<Case, Error>,
+    show_progress: bool,
+    write: impl FnOnce(&Case, &Film) -> Result<Vec<PathBuf>, Error>,
+) -> Result<Rendered, Error> {
+    let start = Instant::now();
+    let case = load()?;
+    let parse = start.elapsed();
+    let (scene, build_stats) = build_scene_measured(&case)?;
+    let build = start.elapsed() - parse;
+    let render_start = Instant::now();
+    let (film, rays) = render_counting_rays(&scene, &render_options(&case), &progress(&case, show_progress));
+    let render = render_start.elapsed();
+    // Freed before the outputs are encoded, as `render_case` does, so measuring adds no memory.
+    drop(scene);
+    let write_start = Instant::now();
+    let written = write(&case, &film)?;
+    let phases = Phases { parse, build, render, write: write_start.elapsed(), total: start.elapsed() };
+    let stats = RenderStats::new(&case, phases, build_stats, &rays, rayon::current_num_threads());
+    Ok(Rendered { written, stats })
 }
 
 /// `goldray import`: the TOML case equivalent to a course scene file, with asset paths

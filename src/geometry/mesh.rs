@@ -2,6 +2,7 @@
 //! instance that places the mesh in a scene.
 
 use std::path::PathBuf;
+use std::time::{Duration, Instant};
 
 use crate::geometry::aabb::Aabb;
 use crate::geometry::bvh::Bvh;
@@ -102,6 +103,8 @@ pub struct Mesh {
     normal_indices: Vec<[u32; 3]>,
     normals: Vec<Vec3>,
     bvh: Bvh,
+    /// Kept for render statistics, which report BVH builds apart from OBJ parsing.
+    bvh_build_time: Duration,
 }
 
 impl Mesh {
@@ -138,7 +141,9 @@ impl Mesh {
             .iter()
             .map(|&t| Aabb::from_points(corners_of(t)))
             .collect();
+        let build_start = Instant::now();
         let (bvh, order) = Bvh::build(&bounds).into_leaf_order();
+        let bvh_build_time = build_start.elapsed();
         Ok(Mesh {
             corners: order
                 .iter()
@@ -147,6 +152,7 @@ impl Mesh {
             normal_indices: order.iter().map(|&i| normal_indices[i as usize]).collect(),
             normals,
             bvh,
+            bvh_build_time,
         })
     }
 
@@ -212,6 +218,11 @@ impl Mesh {
     /// The acceleration structure, for statistics (node and leaf counts).
     pub fn bvh(&self) -> &Bvh {
         &self.bvh
+    }
+
+    /// How long [`Mesh::new`] took to build the BVH (the rest of a load is reading the file).
+    pub fn bvh_build_time(&self) -> Duration {
+        self.bvh_build_time
     }
 }
 

@@ -2,6 +2,7 @@
 //! ray, so the "recursion" is a loop that carries the product of specular colours. That makes
 //! `bounces = 64` (or 1024) cost nothing on the stack.
 
+use super::counter::RayCounts;
 use crate::geometry::Ray;
 use crate::geometry::spawn::{spawn_ray, spawn_ray_to};
 use crate::real::{Color, Real, Vec3};
@@ -18,8 +19,9 @@ impl<'a> Whitted<'a> {
         Whitted { scene, bounces, shadows }
     }
 
-    /// The colour seen along a primary ray, and what that ray hit first (for the AOVs).
-    pub fn trace(&self, primary: Ray) -> (Color, Option<Intersection>) {
+    /// The colour seen along a primary ray, and what that ray hit first (for the AOVs). The
+    /// caller counts the primary ray; the shadow and reflection rays it spawns are added to `rays`.
+    pub fn trace(&self, primary: Ray, rays: &mut RayCounts) -> (Color, Option<Intersection>) {
         let scene = self.scene;
         let mut color = Color::ZERO;
         let mut throughput = Color::ONE;
@@ -34,7 +36,7 @@ impl<'a> Whitted<'a> {
                 first = Some(hit);
             }
             let material = &scene.materials[hit.material as usize];
-            color += throughput * self.direct_light(&ray, &hit);
+            color += throughput * self.direct_light(&ray, &hit, rays);
             if depth == self.bounces || !material.reflects() {
                 break;
             }
@@ -43,12 +45,13 @@ impl<'a> Whitted<'a> {
             let incoming = ray.direction.normalize();
             let reflected = incoming - 2.0 * incoming.dot(normal) * normal;
             ray = spawn_ray(&hit.surface, reflected);
+            rays.reflection += 1;
         }
         (color, first)
     }
 
     /// Ambient plus every light that reaches the point (all of them without `shadows`).
-    fn direct_light(&self, ray: &Ray, hit: &Intersection) -> Color {
+    fn direct_light(&self, ray: &Ray, hit: &Intersection, rays: &mut RayCounts) -> Color {
         let scene = self.scene;
         let material = &scene.materials[hit.material as usize];
         let surface = &hit.surface;
@@ -56,8 +59,11 @@ impl<'a> Whitted<'a> {
         let mut color = scene.ambient * material.diffuse;
         for light in &scene.lights {
             let incident = light.incident(surface.point);
-            if self.shadows && self.blocked(hit, incident.to_light, incident.position) {
-                continue;
+            if self.shadows {
+                rays.shadow += 1;
+                if self.blocked(hit, incident.to_light, incident.position) {
+                    continue;
+                }
             }
             color += material.shade(surface.shading_normal, incident.to_light, to_eye, incident.intensity);
         }

@@ -2,6 +2,7 @@
 //! the supersampling filter.
 
 pub mod camera;
+pub mod counter;
 pub mod integrator;
 pub mod light;
 pub mod material;
@@ -10,7 +11,8 @@ pub mod renderer;
 pub mod sampler;
 
 pub use progress::Progress;
-pub use renderer::{RenderOptions, render};
+pub use counter::RayCounts;
+pub use renderer::{RenderOptions, render, render_counting_rays};
 
 use serde::Deserialize;
 

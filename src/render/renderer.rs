@@ -4,6 +4,7 @@
 use rayon::prelude::*;
 
 use super::Filter;
+use super::counter::{NoCount, RayCounter, RayCounts};
 use super::integrator::Whitted;
 use super::progress::Progress;
 use super::sampler::Sampler;
@@ -29,7 +30,24 @@ pub struct RenderOptions {
     pub filter: Filter,
 }
 
+/// Renders the scene without counting anything.
 pub fn render(scene: &Scene, options: &RenderOptions, progress: &Progress) -> Film {
+    render_counted::<NoCount>(scene, options, progress).0
+}
+
+/// [`render`], also counting every ray traced, by kind (for `--stats`). The film is the same.
+pub fn render_counting_rays(scene: &Scene, options: &RenderOptions, progress: &Progress) -> (Film, RayCounts) {
+    render_counted::<RayCounts>(scene, options, progress)
+}
+
+/// The render loop. Every pixel counts its rays into a [`RayCounts`] of its own, the same code
+/// whatever `C` is, and each band adds its pixels' counts into a `C`; the bands' `C`s are merged
+/// once they finish. With [`NoCount`] the adding compiles away. The film does not depend on `C`.
+///
+/// Private, so that its only two copies are those above, compiled in this crate: a copy
+/// instantiated in another crate (a benchmark, say) would be optimised differently from the one
+/// the command line runs.
+fn render_counted<C: RayCounter>(scene: &Scene, options: &RenderOptions, progress: &Progress) -> (Film, C) {
     let mut film = Film::new(options.width, options.height);
     let pixels = PixelRenderer {
         scene,
@@ -39,24 +57,29 @@ pub fn render(scene: &Scene, options: &RenderOptions, progress: &Progress) -> Fi
     };
     let width = options.width as usize;
     let band = width * BAND_ROWS;
-    film.color
+    let counter = film.color
         .par_chunks_mut(band)
         .zip(film.depth.par_chunks_mut(band))
         .zip(film.normal.par_chunks_mut(band))
         .enumerate()
-        .for_each(|(band_index, ((color, depth), normal))| {
+        .map(|(band_index, ((color, depth), normal))| {
+            let mut counter = C::default();
             for (offset, ((color, depth), normal)) in color.iter_mut().zip(depth).zip(normal).enumerate() {
                 let index = band_index * band + offset;
                 let (x, y) = ((index % width) as u32, (index / width) as u32);
-                let pixel = pixels.pixel(x, y);
+                let mut rays = RayCounts::default();
+                let pixel = pixels.pixel(x, y, &mut rays);
+                counter.add(&rays);
                 *color = film_vector(pixel.color);
                 *depth = pixel.depth;
                 *normal = pixel.normal;
             }
             progress.advance((color.len() / width) as u64);
-        });
+            counter
+        })
+        .reduce(C::default, C::merge);
     progress.finish();
-    film
+    (film, counter)
 }
 
 struct Pixel {
@@ -73,45 +96,49 @@ struct PixelRenderer<'a> {
 }
 
 impl PixelRenderer<'_> {
-    fn pixel(&self, x: u32, y: u32) -> Pixel {
+    /// The pixel's colour and AOVs; every ray traced for it is added to `rays`.
+    fn pixel(&self, x: u32, y: u32, rays: &mut RayCounts) -> Pixel {
         let (width, height) = (self.options.width, self.options.height);
         let centre = Vec2::new(x as Real + 0.5, y as Real + 0.5);
         match self.options.filter {
             Filter::None if self.sampler.samples_per_pixel() == 1 => {
-                let (color, first) = self.integrator.trace(self.scene.camera.ray(centre, width, height));
+                rays.camera += 1;
+                let (color, first) = self.integrator.trace(self.scene.camera.ray(centre, width, height), rays);
                 Pixel::new(color, first.as_ref())
             }
             Filter::None => {
-                let color = self.samples(x, y, width, height);
-                Pixel::new(color, self.first_hit(centre).as_ref())
+                let color = self.samples(x, y, width, height, rays);
+                Pixel::new(color, self.first_hit(centre, rays).as_ref())
             }
             Filter::Gaussian => {
                 let mut color = Color::ZERO;
                 for (j, wy) in GAUSSIAN_WEIGHTS.iter().enumerate() {
                     for (i, wx) in GAUSSIAN_WEIGHTS.iter().enumerate() {
-                        let sub = self.samples(3 * x + i as u32, 3 * y + j as u32, 3 * width, 3 * height);
+                        let sub = self.samples(3 * x + i as u32, 3 * y + j as u32, 3 * width, 3 * height, rays);
                         color += sub * (wx * wy);
                     }
                 }
-                Pixel::new(color, self.first_hit(centre).as_ref())
+                Pixel::new(color, self.first_hit(centre, rays).as_ref())
             }
         }
     }
 
     /// Mean colour of a (sub)pixel's stratified samples in an image of `width × height`.
-    fn samples(&self, x: u32, y: u32, width: u32, height: u32) -> Color {
+    fn samples(&self, x: u32, y: u32, width: u32, height: u32, rays: &mut RayCounts) -> Color {
         let count = self.sampler.samples_per_pixel();
         let origin = Vec2::new(x as Real, y as Real);
+        rays.camera += u64::from(count);
         let sum = (0..count).fold(Color::ZERO, |sum, index| {
             let raster = origin + self.sampler.offset(x, y, index);
-            sum + self.integrator.trace(self.scene.camera.ray(raster, width, height)).0
+            sum + self.integrator.trace(self.scene.camera.ray(raster, width, height), rays).0
         });
         sum / count as Real
     }
 
     /// The AOVs come from one ray through the output pixel's centre: depth and normals averaged
     /// across an edge would describe no surface at all.
-    fn first_hit(&self, centre: Vec2) -> Option<Intersection> {
+    fn first_hit(&self, centre: Vec2, rays: &mut RayCounts) -> Option<Intersection> {
+        rays.aov += 1;
         let ray = self.scene.camera.ray(centre, self.options.width, self.options.height);
         self.scene.geometry.intersect(&ray)
     }

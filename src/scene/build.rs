@@ -4,6 +4,7 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+use std::time::Instant;
 
 use glam::{DMat4, DVec3};
 
@@ -18,6 +19,7 @@ use crate::render::Profile;
 use crate::render::camera::Camera;
 use crate::render::light::Light;
 use crate::render::material::Material;
+use crate::stats::{BuildStats, BvhStats, MeshStats};
 
 #[derive(Debug, thiserror::Error)]
 pub enum BuildError {
@@ -30,6 +32,12 @@ pub enum BuildError {
 }
 
 pub fn build_scene(case: &Case) -> Result<Scene, BuildError> {
+    build_scene_measured(case).map(|(scene, _)| scene)
+}
+
+/// [`build_scene`], also reporting each mesh's load and BVH build and the scene's BVH, for
+/// `--stats`.
+pub fn build_scene_measured(case: &Case) -> Result<(Scene, BuildStats), BuildError> {
     let camera_spec = &case.camera;
     let camera = Camera::new(
         case.render.profile,
@@ -38,12 +46,14 @@ pub fn build_scene(case: &Case) -> Result<Scene, BuildError> {
         vec3(camera_spec.up),
         real(camera_spec.fov),
     );
+    let cube_map_start = Instant::now();
     let background = match &case.background.cube_map {
         Some(dir) => Background::CubeMap(Box::new(
             CubeMap::load(dir).map_err(|source| BuildError::CubeMap { file: case.path.clone(), source })?,
         )),
         None => Background::Color(vec3(case.background.color)),
     };
+    let cube_map_load_time = case.background.cube_map.as_ref().map(|_| cube_map_start.elapsed());
     let mut materials: Vec<Material> = case
         .materials
         .iter()
@@ -57,6 +67,7 @@ pub fn build_scene(case: &Case) -> Result<Scene, BuildError> {
         },
         default_material,
         meshes: HashMap::new(),
+        mesh_stats: Vec::new(),
         objects: Vec::new(),
         planes: Vec::new(),
         uses_default_material: false,
@@ -67,14 +78,18 @@ pub fn build_scene(case: &Case) -> Result<Scene, BuildError> {
     if builder.uses_default_material {
         materials.push(Material::default());
     }
-    Ok(Scene {
+    let bvh_start = Instant::now();
+    let geometry = Aggregate::new(builder.objects, builder.planes);
+    let scene_bvh = geometry.bvh().map(|bvh| BvhStats::of(bvh, bvh_start.elapsed()));
+    let scene = Scene {
         camera,
         background,
         ambient: vec3(case.background.ambient),
         lights: case.lights.iter().map(light).collect(),
         materials,
-        geometry: Aggregate::new(builder.objects, builder.planes),
-    })
+        geometry,
+    };
+    Ok((scene, BuildStats { cube_map_load_time, meshes: builder.mesh_stats, scene_bvh }))
 }
 
 fn light(spec: &LightSpec) -> Light {
@@ -92,6 +107,7 @@ struct Builder {
     normals: NormalSource,
     default_material: u32,
     meshes: HashMap<PathBuf, Arc<Mesh>>,
+    mesh_stats: Vec<MeshStats>,
     objects: Vec<Object>,
     planes: Vec<(Plane, u32)>,
     uses_default_material: bool,
@@ -150,7 +166,15 @@ impl Builder {
         if let Some(mesh) = self.meshes.get(path) {
             return Ok(mesh.clone());
         }
+        let start = Instant::now();
         let mesh = Arc::new(Mesh::load_obj(path, self.normals)?);
+        let bvh_build_time = mesh.bvh_build_time();
+        self.mesh_stats.push(MeshStats {
+            path: path.to_path_buf(),
+            triangles: mesh.triangle_count(),
+            load_time: start.elapsed().saturating_sub(bvh_build_time),
+            bvh: BvhStats::of(mesh.bvh(), bvh_build_time),
+        });
         self.meshes.insert(path.to_path_buf(), mesh.clone());
         Ok(mesh)
     }

@@ -6,7 +6,7 @@ mod cube_map;
 mod object;
 
 pub use aggregate::{Aggregate, Intersection};
-pub use build::{BuildError, build_scene};
+pub use build::{BuildError, build_scene, build_scene_measured};
 pub use cube_map::{CubeMap, CubeMapError};
 pub use object::{Object, Shape, ShapeHit, Triangle};
 
