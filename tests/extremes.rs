@@ -8,7 +8,7 @@ use goldray::film::Film;
 use goldray::geometry::Ray;
 use goldray::pipeline::render_case;
 use goldray::real::{Color, Real, Vec3};
-use goldray::render::Profile;
+use goldray::render::{Profile, RayCounts};
 use goldray::render::camera::Camera;
 use goldray::render::integrator::Whitted;
 use goldray::render::light::Light;
@@ -244,8 +244,9 @@ proptest! {
             geometry: Aggregate::new(objects, vec![(Plane::new(Vec3::Y, -3.0), 0)]),
         };
         let integrator = Whitted::new(&scene, 8, true);
+        let mut counts = RayCounts::default();
         for (origin, direction) in rays {
-            let (color, _) = integrator.trace(Ray::new(origin, direction));
+            let (color, _) = integrator.trace(Ray::new(origin, direction), &mut counts);
             prop_assert!(color.is_finite(), "{color} along {origin} + t{direction}");
         }
     }
