@@ -158,31 +158,15 @@ fn verdicts_carry_the_evidence_behind_them() {
         by("wrong_sizes", 0).student_image.is_some(),
         "a wrong-sized picture is still shown"
     );
-    assert!(
-        by("missing_and_corrupt", 1).explanation.contains("truncated"),
-        "{}",
-        by("missing_and_corrupt", 1).explanation
-    );
-    assert!(
-        by("missing_and_corrupt", 2).explanation.contains("corrupt"),
-        "{}",
-        by("missing_and_corrupt", 2).explanation
-    );
-    assert!(
-        by("bad_files", 0).explanation.contains("OpenEXR"),
-        "{}",
-        by("bad_files", 0).explanation
-    );
-    assert!(
-        by("bad_files", 1).explanation.contains("50000×50000"),
-        "{}",
-        by("bad_files", 1).explanation
-    );
-    assert!(
-        by("bad_files", 2).explanation.contains("MiB decoded"),
-        "{}",
-        by("bad_files", 2).explanation
-    );
+    let explains = |student: &str, image: usize, needle: &str| {
+        let explanation = &by(student, image).explanation;
+        assert!(explanation.contains(needle), "{student}, image {image}: {explanation}");
+    };
+    explains("missing_and_corrupt", 1, "truncated");
+    explains("missing_and_corrupt", 2, "corrupt");
+    explains("bad_files", 0, "OpenEXR");
+    explains("bad_files", 1, "50000×50000");
+    explains("bad_files", 2, "MiB decoded");
 
     let notes = |name: &str, file: usize| by(name, file).notes.join("; ");
     assert!(notes("formats", 0).contains("alpha ignored"), "{}", notes("formats", 0));
