@@ -12,6 +12,10 @@ pub struct Transform {
     /// Inverse transpose of the linear part: normals stay perpendicular to surfaces under
     /// non-uniform scale.
     normal_to_world: Mat3,
+    /// `|M|` and `|M⁻¹|` entry by entry (linear part, translation), the factors of every
+    /// error bound below; constants of the transform, so computed once rather than per ray.
+    abs_object_to_world: (Mat3, Vec3),
+    abs_world_to_object: (Mat3, Vec3),
 }
 
 /// Why a transform cannot be used.
@@ -50,7 +54,14 @@ impl Transform {
             return Err(TransformError::Singular);
         }
         let normal_to_world = linear.inverse().transpose();
-        Ok(Transform { object_to_world, world_to_object, normal_to_world })
+        let absolute = |m: Mat4| (Mat3::from_mat4(m).abs(), m.w_axis.truncate().abs());
+        Ok(Transform {
+            object_to_world,
+            world_to_object,
+            normal_to_world,
+            abs_object_to_world: absolute(object_to_world),
+            abs_world_to_object: absolute(world_to_object),
+        })
     }
 
     pub fn object_to_world(&self) -> &Mat4 {
@@ -69,9 +80,8 @@ impl Transform {
         if length_squared == 0.0 {
             return (Ray::new(origin, direction), 0.0);
         }
-        let abs_linear = Mat3::from_mat4(self.world_to_object).abs();
-        let translation = self.world_to_object.w_axis.truncate().abs();
-        let origin_error = gamma(3) * (abs_linear * ray.origin.abs() + translation);
+        let (abs_linear, abs_translation) = self.abs_world_to_object;
+        let origin_error = gamma(3) * (abs_linear * ray.origin.abs() + abs_translation);
         let shift = direction.abs().dot(origin_error) / length_squared;
         (Ray::new(origin + direction * shift, direction), shift)
     }
@@ -98,10 +108,8 @@ impl Transform {
     /// or under anisotropic scale, the return trip alone can otherwise re-hit the surface).
     pub fn hit_to_world(&self, hit: &SurfaceHit) -> SurfaceHit {
         let point = self.point_to_world(hit.point);
-        let abs_linear = Mat3::from_mat4(self.object_to_world).abs();
-        let translation = self.object_to_world.w_axis.truncate().abs();
-        let abs_inverse_linear = Mat3::from_mat4(self.world_to_object).abs();
-        let inverse_translation = self.world_to_object.w_axis.truncate().abs();
+        let (abs_linear, translation) = self.abs_object_to_world;
+        let (abs_inverse_linear, inverse_translation) = self.abs_world_to_object;
         let forward_error = gamma(3) * (abs_linear * hit.point.abs() + translation)
             + (1.0 + gamma(3)) * (abs_linear * hit.point_error);
         let return_error = gamma(3) * (abs_inverse_linear * point.abs() + inverse_translation);
