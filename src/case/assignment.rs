@@ -16,10 +16,10 @@ use std::path::Path;
 use lexer::{Lexer, Result, Token, Vec3, quote};
 
 use super::error::{CaseError, suggest};
-use super::sections::{self, MAX_BOUNCES};
+use super::sections::MAX_BOUNCES;
 use super::spec::{BackgroundSpec, Case, MaterialSpec};
-use super::value::{Doc, has_usable_length};
-use super::{LoadOptions, RenderSettings};
+use super::value::has_usable_length;
+use super::RenderSettings;
 use crate::film::Tonemap;
 use crate::render::{Filter, Profile};
 
@@ -133,25 +133,13 @@ pub fn parse_assignment_scene(
         path: path.to_path_buf(),
         description: None,
         render,
-        tolerance: default_tolerance(path, source, dir),
+        tolerance: super::Tolerance::DEFAULT,
         camera,
         background,
         lights,
         materials: parser.materials,
         objects,
     })
-}
-
-/// The TOML loader's own default, taken from it so that the two cannot drift apart.
-fn default_tolerance(path: &Path, text: &str, dir: &Path) -> super::Tolerance {
-    let options = LoadOptions::default();
-    let doc = Doc {
-        file: path,
-        text,
-        dir,
-        options: &options,
-    };
-    sections::tolerance(&doc, None).expect("an absent [tolerance] reads as the defaults")
 }
 
 /// The options come from the command line, not the file, so their errors have no line.

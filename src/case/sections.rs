@@ -128,9 +128,10 @@ fn samples(f: &Field) -> Result<u32> {
 pub(crate) fn tolerance<'a>(doc: &'a Doc<'a>, field: Option<Field<'a, '_>>) -> Result<Tolerance> {
     let t = section(doc, field, "[tolerance]")?;
     t.check_keys(&["pixel", "fail_fraction", "rmse", "max"])?;
+    let default = Tolerance::DEFAULT;
     Ok(Tolerance {
-        pixel: t.read("pixel", 0.01, Field::non_negative)?,
-        fail_fraction: t.read("fail_fraction", 0.001, |f| {
+        pixel: t.read("pixel", default.pixel, Field::non_negative)?,
+        fail_fraction: t.read("fail_fraction", default.fail_fraction, |f| {
             let v = f.number()?;
             if (0.0..=1.0).contains(&v) {
                 Ok(v)
@@ -138,8 +139,8 @@ pub(crate) fn tolerance<'a>(doc: &'a Doc<'a>, field: Option<Field<'a, '_>>) -> R
                 Err(f.invalid("must be between 0 and 1"))
             }
         })?,
-        rmse: t.read("rmse", 0.002, Field::non_negative)?,
-        max: t.read("max", None, |f| f.non_negative().map(Some))?,
+        rmse: t.read("rmse", default.rmse, Field::non_negative)?,
+        max: t.read("max", default.max, |f| f.non_negative().map(Some))?,
     })
 }
 

@@ -54,6 +54,12 @@ pub struct Tolerance {
     pub max: Option<f64>,
 }
 
+impl Tolerance {
+    /// What a case without `[tolerance]` gets, and what `goldray diff` applies to two EXRs: one
+    /// definition, so the suite and the command judge alike.
+    pub const DEFAULT: Tolerance = Tolerance { pixel: 0.01, fail_fraction: 0.001, rmse: 0.002, max: None };
+}
+
 /// `direction` and `up` have nonzero length and are not parallel; `fov` is in (0, 180) degrees.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CameraSpec {

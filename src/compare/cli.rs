@@ -15,12 +15,7 @@ use crate::film::write_png;
 pub const UNREADABLE: u8 = 4;
 
 /// The case-file defaults, so that `goldray diff` on two EXRs judges like the golden suite.
-pub const EXR_DEFAULTS: Tolerance = Tolerance {
-    pixel: 0.01,
-    fail_fraction: 0.001,
-    rmse: 0.002,
-    max: None,
-};
+pub const EXR_DEFAULTS: Tolerance = Tolerance::DEFAULT;
 
 /// The same limits in 8-bit code values: an off-by-one code (rounding, or an ulp of drift at a
 /// quantisation boundary) is within `pixel`; `rmse` is 0.002 × 255 ≈ 0.5 codes, so a uniform
