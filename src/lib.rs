@@ -14,5 +14,6 @@ pub mod real;
 pub mod render;
 pub mod scene;
 pub mod stats;
+pub mod tradeoff;
 
 pub use error::Error;

@@ -79,6 +79,10 @@ enum Command {
     /// Grade folders of student renders against a rubric's golden images: writes grades.csv,
     /// grades.json and an HTML report. Exit code 0 whenever grading ran, whatever the grades.
     Grade(goldray::grade::GradeArgs),
+    /// Measure the speed-accuracy trade: render a case over samples × filter and bounces, time
+    /// each setting and count its rays, measure its error against a converged reference, and
+    /// write tradeoff.csv, tradeoff.md and a log-log plot tradeoff.png with the Pareto front.
+    Tradeoff(goldray::tradeoff::TradeoffArgs),
 }
 
 /// The course binary's rendering flags, shared by `mit6837` and `import` so that an imported
@@ -196,6 +200,9 @@ fn run(cli: Cli) -> Result<ExitCode, String> {
         }
         Command::Diff(args) => Ok(ExitCode::from(goldray::compare::run_diff(&args))),
         Command::Grade(args) => goldray::grade::run_grade(&args).map(|_| ExitCode::SUCCESS).map_err(|e| e.to_string()),
+        Command::Tradeoff(args) => {
+            goldray::tradeoff::run_tradeoff_command(&args).map(|_| ExitCode::SUCCESS).map_err(|e| e.to_string())
+        }
     }
 }
 

@@ -1,0 +1,209 @@
+//! `goldray tradeoff`'s command line: flags, their checks (a bad value is refused before
+//! anything renders or is written), and what the command prints.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use super::error::TradeoffError;
+use super::measure::Metric;
+use super::report::significant;
+use super::sweep::{DEFAULT_FILTERS, SweepPlan, filter_name};
+use super::{Tradeoff, TradeoffOptions, run_tradeoff};
+use crate::case::{MAX_BOUNCES, MAX_IMAGE_SIZE, case_name};
+use crate::render::Filter;
+
+/// Render a case over a sweep of samples, filters and bounces; measure each setting's time, rays
+/// and error against a converged reference; write tradeoff.csv, tradeoff.md and a log-log plot
+/// tradeoff.png with the Pareto front marked.
+#[derive(Clone, Debug, clap::Args)]
+pub struct TradeoffArgs {
+    /// The case file.
+    pub case: PathBuf,
+    /// Where to write tradeoff.csv, tradeoff.md and tradeoff.png [default: tradeoff/NAME].
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Print (and record in tradeoff.md) the fastest setting whose FLIP mean is at most X
+    /// (0 = identical to the reference, 1 = as different as can be).
+    #[arg(long, value_name = "X", value_parser = parse_flip)]
+    pub target_flip: Option<f64>,
+    /// Samples per pixel of the grid: comma-separated perfect squares.
+    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_square,
+          default_values_t = SweepPlan::default().samples)]
+    pub samples: Vec<u32>,
+    /// Filters of the grid: comma-separated, from none and gaussian (3× supersampling, 9× the rays).
+    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_filter,
+          default_values = DEFAULT_FILTERS.map(filter_name))]
+    pub filters: Vec<Filter>,
+    /// Render every setting and the reference at this size instead of the case's (e.g. 64x48):
+    /// a quicker sweep.
+    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+    /// Stratified samples per pixel of the reference: a perfect square above every --samples.
+    #[arg(long, value_name = "N", value_parser = parse_square,
+          default_value_t = SweepPlan::default().reference_samples)]
+    pub reference_samples: u32,
+    /// The bounce sweep stops at this many bounces even if the picture is still changing.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(0..=MAX_BOUNCES),
+          default_value_t = SweepPlan::default().max_bounces)]
+    pub max_bounces: u32,
+    /// The bounce sweep stops once one more bounce changes no pixel's colour by more than this
+    /// (linear units, 1 = white).
+    #[arg(long, value_name = "T", value_parser = parse_threshold,
+          default_value_t = SweepPlan::default().bounce_threshold)]
+    pub bounce_threshold: f64,
+    /// Render each setting again until its runs add up to S seconds (at most 50 runs) and keep
+    /// the fastest run; 0 renders each setting once (quicker, noisier times).
+    #[arg(long, value_name = "S", value_parser = parse_seconds,
+          default_value_t = SweepPlan::default().min_time.as_secs_f64())]
+    pub min_time: f64,
+    /// The error the plot and the Pareto front rank settings by.
+    #[arg(long, value_enum, default_value_t = Metric::Rmse)]
+    pub metric: Metric,
+    /// Worker threads (default: one per core). Times depend on it; pictures and rays do not.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub threads: Option<u32>,
+    /// No progress bar and no summary (the --target-flip answer is still printed).
+    #[arg(long)]
+    pub quiet: bool,
+    /// Replace tradeoff.csv, tradeoff.md or tradeoff.png in DIR even when goldray did not write them.
+    #[arg(long)]
+    pub force: bool,
+}
+
+impl TradeoffArgs {
+    pub fn options(&self) -> TradeoffOptions {
+        TradeoffOptions {
+            out: self.out.clone().unwrap_or_else(|| PathBuf::from("tradeoff").join(case_name(&self.case))),
+            plan: SweepPlan {
+                samples: self.samples.clone(),
+                filters: self.filters.clone(),
+                max_bounces: self.max_bounces,
+                bounce_threshold: self.bounce_threshold,
+                reference_samples: self.reference_samples,
+                size: self.size,
+                min_time: Duration::from_secs_f64(self.min_time),
+            },
+            metric: self.metric,
+            target_flip: self.target_flip,
+            force: self.force,
+            show_progress: !self.quiet,
+        }
+    }
+}
+
+/// Runs `goldray tradeoff` on its own thread pool and prints the summary to standard output.
+pub fn run_tradeoff_command(args: &TradeoffArgs) -> Result<Tradeoff, TradeoffError> {
+    let mut pool = rayon::ThreadPoolBuilder::new();
+    if let Some(threads) = args.threads {
+        pool = pool.num_threads(threads as usize);
+    }
+    let options = args.options();
+    let (tradeoff, written) = pool.build()?.install(|| run_tradeoff(&args.case, &options))?;
+    if !args.quiet {
+        println!("{}", summary(&tradeoff));
+        for path in &written {
+            println!("wrote {}", path.display());
+        }
+    }
+    if let Some(sentence) = tradeoff.target_sentence() {
+        println!("target: {sentence}");
+    }
+    Ok(tradeoff)
+}
+
+/// What the terminal shows: the sweep's size, the bounce finding and the Pareto front.
+fn summary(t: &Tradeoff) -> String {
+    let front: Vec<String> = t
+        .front()
+        .map(|m| format!("{} ({} s, {} {})", m.setting.label(), significant(m.seconds), t.metric.name(), significant(t.metric.of(&m.errors))))
+        .collect();
+    format!(
+        "{} at {}×{}: {} settings against a {} spp reference ({} bounces, {} s)\nbounces: {}\nPareto front: {}",
+        t.case_name,
+        t.width,
+        t.height,
+        t.measurements.len(),
+        t.reference.samples,
+        t.reference.bounces,
+        significant(t.reference.seconds),
+        super::report::bounce_sentence(t),
+        front.join(", ")
+    )
+}
+
+fn parse_square(text: &str) -> Result<u32, String> {
+    let n: u32 = text.trim().parse().map_err(|_| format!("`{text}` is not a whole number"))?;
+    let root = n.isqrt();
+    if n == 0 || root * root != n {
+        let up = root + 1;
+        return Err(format!(
+            "{n} is not a perfect square: samples lie on an n×n grid (the nearest are {} and {})",
+            (root * root).max(1),
+            up * up
+        ));
+    }
+    Ok(n)
+}
+
+fn parse_filter(text: &str) -> Result<Filter, String> {
+    match text.trim() {
+        "none" => Ok(Filter::None),
+        "gaussian" => Ok(Filter::Gaussian),
+        other => Err(format!("`{other}` is not a filter: none or gaussian")),
+    }
+}
+
+fn parse_size(text: &str) -> Result<(u32, u32), String> {
+    let usage = || format!("`{text}` is not a size: give WIDTHxHEIGHT, e.g. 64x48");
+    let (width, height) = text.split_once(['x', 'X', '×']).ok_or_else(usage)?;
+    let side = |s: &str| s.trim().parse::<u32>().ok().filter(|&v| v >= 1 && i64::from(v) <= MAX_IMAGE_SIZE);
+    match (side(width), side(height)) {
+        (Some(w), Some(h)) => Ok((w, h)),
+        _ => Err(format!("{} (each side between 1 and {MAX_IMAGE_SIZE})", usage())),
+    }
+}
+
+fn parse_flip(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(x) if (0.0..=1.0).contains(&x) => Ok(x),
+        _ => Err(format!("`{text}` is not a FLIP mean: a number from 0 to 1")),
+    }
+}
+
+fn parse_seconds(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(x) if (0.0..=3600.0).contains(&x) => Ok(x),
+        _ => Err(format!("`{text}` is not a time: a number of seconds from 0 to 3600")),
+    }
+}
+
+fn parse_threshold(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(x) if x.is_finite() && x >= 0.0 => Ok(x),
+        _ => Err(format!("`{text}` is not a threshold: a finite number ≥ 0")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn flag_values_are_checked_with_reasons() {
+        assert_eq!(parse_square("16"), Ok(16));
+        assert!(parse_square("8").unwrap_err().contains("nearest are 4 and 9"));
+        assert!(parse_square("0").unwrap_err().contains("perfect square"));
+        assert!(parse_square("four").unwrap_err().contains("whole number"));
+        assert_eq!(parse_size("64x48"), Ok((64, 48)));
+        assert!(parse_size("64").unwrap_err().contains("WIDTHxHEIGHT"));
+        assert!(parse_size("0x10").unwrap_err().contains("between 1"));
+        assert!(parse_size("99999x10").unwrap_err().contains("16384"));
+        assert_eq!(parse_filter("gaussian"), Ok(Filter::Gaussian));
+        assert!(parse_filter("box").unwrap_err().contains("none or gaussian"));
+        assert_eq!(parse_flip("0.05"), Ok(0.05));
+        assert!(parse_flip("1.5").is_err() && parse_flip("nan").is_err());
+        assert!(parse_threshold("-1").is_err() && parse_threshold("inf").is_err());
+        assert_eq!(parse_seconds("0"), Ok(0.0));
+        assert!(parse_seconds("-0.5").is_err() && parse_seconds("nan").is_err());
+    }
+}
