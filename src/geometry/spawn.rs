@@ -3,7 +3,7 @@
 //! (pbrt-v4 `OffsetRayOrigin`).
 
 use super::ray::{Ray, SurfaceHit};
-use crate::real::{Real, Vec3};
+use super::real::{Real, Vec3};
 
 /// Shadow rays to a point stop this fraction short of it, so that a light sitting on a surface
 /// is not shadowed by that surface. Relative, so it scales with the scene.
@@ -61,7 +61,7 @@ mod tests {
 
     #[test]
     fn an_offset_lost_to_rounding_still_moves_one_ulp() {
-        let hit = hit_at(Vec3::new(0.0, 1.0, 0.0), Vec3::splat(1.0e-12));
+        let hit = hit_at(Vec3::new(0.0, 1.0, 0.0), Vec3::splat(Real::EPSILON * 1.0e-4));
         let ray = spawn_ray(&hit, Vec3::Y);
         assert_eq!(ray.origin.y, (1.0 as Real).next_up());
     }

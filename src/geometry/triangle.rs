@@ -9,8 +9,8 @@
 
 use glam::Vec3Swizzles;
 
-use crate::geometry::{Ray, SurfaceHit};
-use crate::real::{Real, Vec3, gamma};
+use super::{Ray, SurfaceHit};
+use super::real::{Real, Vec3, gamma};
 
 /// The per-ray part of the test: which axis becomes z, and the shear that makes the ray
 /// direction (0, 0, 1). Computing it once per ray saves that work for every triangle tested.

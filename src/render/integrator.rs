@@ -2,11 +2,11 @@
 //! ray, so the "recursion" is a loop that carries the product of specular colours. That makes
 //! `bounces = 64` (or 1024) cost nothing on the stack.
 
-use super::counter::RayCounts;
-use crate::geometry::Ray;
-use crate::geometry::spawn::{spawn_ray, spawn_ray_to};
-use crate::real::{Color, Real, Vec3};
-use crate::scene::{Intersection, Scene};
+use super::geometry::Ray;
+use super::geometry::spawn::{spawn_ray, spawn_ray_to};
+use super::real::{Color, Real, Vec3};
+use super::scene::{Intersection, Scene};
+use crate::stats::RayCounts;
 
 pub struct Whitted<'a> {
     scene: &'a Scene,

@@ -8,28 +8,19 @@ use std::time::Instant;
 
 use glam::{DMat4, DVec3};
 
-use super::{Aggregate, Background, CubeMap, CubeMapError, Object, Scene, Shape, Triangle};
-use crate::case::{Case, LightSpec, ObjectSpec, ShapeSpec, SourceLocation, composite_matrix};
-use crate::geometry::mesh::{Mesh, MeshError, NormalSource};
-use crate::geometry::plane::Plane;
-use crate::geometry::sphere::Sphere;
-use crate::geometry::transform::{Transform, TransformError};
-use crate::real::{mat4, real, vec3};
-use crate::render::Profile;
-use crate::render::camera::Camera;
-use crate::render::light::Light;
-use crate::render::material::Material;
-use crate::stats::{BuildStats, BvhStats, MeshStats};
-
-#[derive(Debug, thiserror::Error)]
-pub enum BuildError {
-    #[error("{location}: cannot load mesh: {source}")]
-    Mesh { location: SourceLocation, source: MeshError },
-    #[error("{location}: {source}")]
-    Transform { location: SourceLocation, source: TransformError },
-    #[error("{file}: {source}")]
-    CubeMap { file: PathBuf, source: CubeMapError },
-}
+use super::geometry::mesh::{Mesh, NormalSource};
+use super::geometry::plane::Plane;
+use super::geometry::sphere::Sphere;
+use super::geometry::transform::Transform;
+use super::real::{mat4, real, vec3};
+use super::render::camera::Camera;
+use super::render::light::Light;
+use super::render::material::Material;
+use super::{Aggregate, Background, CubeMap, Object, Scene, Shape, Triangle};
+use crate::build_error::{BuildError, MeshError, TransformError};
+use crate::case::{Case, LightSpec, ObjectSpec, ShapeSpec, composite_matrix};
+use crate::options::Profile;
+use crate::stats::{BuildStats, MeshStats};
 
 pub fn build_scene(case: &Case) -> Result<Scene, BuildError> {
     build_scene_measured(case).map(|(scene, _)| scene)
@@ -80,7 +71,7 @@ pub fn build_scene_measured(case: &Case) -> Result<(Scene, BuildStats), BuildErr
     }
     let bvh_start = Instant::now();
     let geometry = Aggregate::new(builder.objects, builder.planes);
-    let scene_bvh = geometry.bvh().map(|bvh| BvhStats::of(bvh, bvh_start.elapsed()));
+    let scene_bvh = geometry.bvh().map(|bvh| bvh.stats(bvh_start.elapsed()));
     let scene = Scene {
         camera,
         background,
@@ -173,7 +164,7 @@ impl Builder {
             path: path.to_path_buf(),
             triangles: mesh.triangle_count(),
             load_time: start.elapsed().saturating_sub(bvh_build_time),
-            bvh: BvhStats::of(mesh.bvh(), bvh_build_time),
+            bvh: mesh.bvh().stats(bvh_build_time),
         });
         self.meshes.insert(path.to_path_buf(), mesh.clone());
         Ok(mesh)
@@ -215,7 +206,7 @@ fn inverse_linear(matrix: DMat4) -> Result<glam::DMat3, TransformError> {
 mod tests {
     use super::*;
 
-    use crate::real::Vec3;
+    use super::super::real::Vec3;
 
     #[test]
     fn transformed_plane_moves_with_its_matrix() {
