@@ -12,7 +12,7 @@ use super::geometry::mesh::{Mesh, NormalSource};
 use super::geometry::plane::Plane;
 use super::geometry::sphere::Sphere;
 use super::geometry::transform::Transform;
-use super::real::{mat4, real, vec3};
+use super::real::{Vec3, mat4, real, vec3};
 use super::render::camera::Camera;
 use super::render::light::Light;
 use super::render::material::Material;
@@ -28,11 +28,18 @@ pub fn build_scene(case: &Case) -> Result<Scene, BuildError> {
 
 /// [`build_scene`], also reporting each mesh's load and BVH build and the scene's BVH, for
 /// `--stats`.
+///
+/// The scene is built in camera-world space (pbrt-v4's default): everything is moved, in `f64`,
+/// so that the camera sits at the origin before any coordinate is rounded to `Real`. Where
+/// rays start is then where precision is finest, and a scene moved far from the origin renders
+/// the same picture instead of losing digits to the distance.
 pub fn build_scene_measured(case: &Case) -> Result<(Scene, BuildStats), BuildError> {
     let camera_spec = &case.camera;
+    let eye = DVec3::from(camera_spec.center);
+    let to_camera_world = (eye != DVec3::ZERO).then(|| DMat4::from_translation(-eye));
     let camera = Camera::new(
         case.render.profile,
-        vec3(camera_spec.center),
+        Vec3::ZERO,
         vec3(camera_spec.direction),
         vec3(camera_spec.up),
         real(camera_spec.fov),
@@ -64,7 +71,7 @@ pub fn build_scene_measured(case: &Case) -> Result<(Scene, BuildStats), BuildErr
         uses_default_material: false,
     };
     for spec in &case.objects {
-        builder.add(spec, None, None)?;
+        builder.add(spec, to_camera_world, None)?;
     }
     if builder.uses_default_material {
         materials.push(Material::default());
@@ -76,18 +83,20 @@ pub fn build_scene_measured(case: &Case) -> Result<(Scene, BuildStats), BuildErr
         camera,
         background,
         ambient: vec3(case.background.ambient),
-        lights: case.lights.iter().map(light).collect(),
+        lights: case.lights.iter().map(|spec| light(spec, eye)).collect(),
         materials,
         geometry,
     };
     Ok((scene, BuildStats { cube_map_load_time, meshes: builder.mesh_stats, scene_bvh }))
 }
 
-fn light(spec: &LightSpec) -> Light {
+fn light(spec: &LightSpec, eye: DVec3) -> Light {
     match *spec {
-        LightSpec::Point { position, color, falloff } => {
-            Light::Point { position: vec3(position), color: vec3(color), falloff: real(falloff) }
-        }
+        LightSpec::Point { position, color, falloff } => Light::Point {
+            position: vec3((DVec3::from(position) - eye).to_array()),
+            color: vec3(color),
+            falloff: real(falloff),
+        },
         LightSpec::Directional { direction, color } => {
             Light::Directional { direction: vec3(direction).normalize(), color: vec3(color) }
         }
@@ -135,7 +144,11 @@ impl Builder {
                 self.objects.push(Object { shape: Shape::Triangle(triangle), transform: None, material });
             }
             ShapeSpec::Sphere { center, radius } => {
-                let shape = Shape::Sphere(Sphere { center: vec3(*center), radius: real(*radius) });
+                let (center, matrix) = match matrix {
+                    Some(m) if is_translation(m) => (m.transform_point3(DVec3::from(*center)), None),
+                    _ => (DVec3::from(*center), matrix),
+                };
+                let shape = Shape::Sphere(Sphere { center: vec3(center.to_array()), radius: real(*radius) });
                 self.push_instanced(shape, matrix, material).map_err(transform_error)?;
             }
             ShapeSpec::Mesh { obj } => {
@@ -169,6 +182,12 @@ impl Builder {
         self.meshes.insert(path.to_path_buf(), mesh.clone());
         Ok(mesh)
     }
+}
+
+/// A translated sphere is a sphere with another centre: moving it costs nothing per ray, where
+/// instancing would transform every ray that meets its box.
+fn is_translation(matrix: DMat4) -> bool {
+    glam::DMat3::from_mat4(matrix) == glam::DMat3::IDENTITY && matrix.row(3) == glam::DVec4::W
 }
 
 /// Planes stay analytic under any affine transform: the normal goes by the inverse transpose
@@ -206,7 +225,6 @@ fn inverse_linear(matrix: DMat4) -> Result<glam::DMat3, TransformError> {
 mod tests {
     use super::*;
 
-    use super::super::real::Vec3;
 
     #[test]
     fn transformed_plane_moves_with_its_matrix() {
