@@ -22,7 +22,7 @@ use goldray::pipeline::{render_case, render_options};
 use goldray::real::{Color, Vec3};
 use goldray::render::camera::Camera;
 use goldray::render::material::Material;
-use goldray::options::{Filter, Profile, RenderOptions};
+use goldray::options::{Filter, Profile, RenderOptions, Spawn};
 use goldray::progress::Progress;
 use goldray::render::{render, render_counting_rays};
 use goldray::scene::{Aggregate, Background, Object, Scene, Shape, build_scene};
@@ -53,6 +53,7 @@ fn primary_rays(c: &mut Criterion) {
         samples: 1,
         seed: 0,
         filter: Filter::None,
+        spawn: Spawn::ErrorBounds,
     };
     let mut group = c.benchmark_group("primary_rays");
     group.sample_size(10);

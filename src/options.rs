@@ -47,6 +47,19 @@ impl Precision {
     }
 }
 
+/// Where secondary (shadow and reflection) rays start.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub enum Spawn {
+    /// Off the surface by exactly the hit point's rounding-error bound, which is right at every
+    /// scale (pbrt-v4). What every command renders with; a case file cannot choose otherwise.
+    #[default]
+    ErrorBounds,
+    /// On the surface, ignoring whatever lies closer than this distance: the classic assignment's
+    /// `tmin = 1e-4`. Offered to library users to show (as tests/scale_invariance.rs does) or
+    /// reproduce what a fixed epsilon does to a scene.
+    FixedEpsilon(f64),
+}
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderOptions {
     pub width: u32,
@@ -56,4 +69,5 @@ pub struct RenderOptions {
     pub samples: u32,
     pub seed: u64,
     pub filter: Filter,
+    pub spawn: Spawn,
 }

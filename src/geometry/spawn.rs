@@ -3,7 +3,8 @@
 //! (pbrt-v4 `OffsetRayOrigin`).
 
 use super::ray::{Ray, SurfaceHit};
-use super::real::{Real, Vec3};
+use super::real::{Real, Vec3, real};
+use crate::options::Spawn;
 
 /// Shadow rays to a point stop this fraction short of it, so that a light sitting on a surface
 /// is not shadowed by that surface. Relative, so it scales with the scene.
@@ -39,6 +40,26 @@ pub fn spawn_ray(hit: &SurfaceHit, direction: Vec3) -> Ray {
 pub fn spawn_ray_to(hit: &SurfaceHit, target: Vec3) -> (Ray, Real) {
     let origin = spawn_ray_offset(hit, target - hit.point);
     (Ray::new(origin, target - origin), 1.0 - SHADOW_RAY_SHORTFALL)
+}
+
+/// A ray leaving `hit` towards `direction`, under `policy`.
+pub fn spawn(policy: Spawn, hit: &SurfaceHit, direction: Vec3) -> Ray {
+    match policy {
+        Spawn::ErrorBounds => spawn_ray(hit, direction),
+        Spawn::FixedEpsilon(epsilon) => Ray::new(hit.point + direction.normalize() * real(epsilon), direction),
+    }
+}
+
+/// [`spawn_ray_to`] under `policy`: a fixed epsilon skips that distance at both ends.
+pub fn spawn_to(policy: Spawn, hit: &SurfaceHit, target: Vec3) -> (Ray, Real) {
+    match policy {
+        Spawn::ErrorBounds => spawn_ray_to(hit, target),
+        Spawn::FixedEpsilon(epsilon) => {
+            let to_target = target - hit.point;
+            let skipped = real(epsilon) / to_target.length();
+            (Ray::new(hit.point + to_target * skipped, to_target), 1.0 - 2.0 * skipped)
+        }
+    }
 }
 
 #[cfg(test)]

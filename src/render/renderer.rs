@@ -41,7 +41,7 @@ fn render_counted<C: RayCounter>(scene: &Scene, options: &RenderOptions, progres
     let mut film = Film::new(options.width, options.height);
     let pixels = PixelRenderer {
         scene,
-        integrator: Whitted::new(scene, options.bounces, options.shadows),
+        integrator: Whitted::new(scene, options.bounces, options.shadows, options.spawn),
         sampler: Sampler::new(options.samples, options.seed),
         options,
     };
