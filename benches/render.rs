@@ -22,7 +22,9 @@ use goldray::pipeline::{render_case, render_options};
 use goldray::real::{Color, Vec3};
 use goldray::render::camera::Camera;
 use goldray::render::material::Material;
-use goldray::render::{Filter, Profile, Progress, RenderOptions, render, render_counting_rays};
+use goldray::options::{Filter, Profile, RenderOptions, Spawn};
+use goldray::progress::Progress;
+use goldray::render::{render, render_counting_rays};
 use goldray::scene::{Aggregate, Background, Object, Scene, Shape, build_scene};
 
 const SIDE: u32 = 256;
@@ -51,6 +53,7 @@ fn primary_rays(c: &mut Criterion) {
         samples: 1,
         seed: 0,
         filter: Filter::None,
+        spawn: Spawn::ErrorBounds,
     };
     let mut group = c.benchmark_group("primary_rays");
     group.sample_size(10);

@@ -6,9 +6,12 @@
 
 mod build;
 
-use crate::geometry::Ray;
-use crate::geometry::aabb::{Aabb, SlabRay};
-use crate::real::Real;
+use std::time::Duration;
+
+use super::Ray;
+use super::aabb::{Aabb, SlabRay};
+use super::real::Real;
+use crate::stats::BvhStats;
 
 /// Deepest tree [`Bvh::build`] can produce: SAH splits are allowed up to `build::SAH_DEPTH_LIMIT`
 /// levels, after which median splits at most halve `u32::MAX` primitives down to a leaf. Sizing
@@ -106,6 +109,11 @@ impl Bvh {
 
     pub fn nodes(&self) -> &[BvhNode] {
         &self.nodes
+    }
+
+    /// Its shape for `--stats`.
+    pub fn stats(&self, build_time: Duration) -> BvhStats {
+        BvhStats { build_time, primitives: self.prim_indices().len(), nodes: self.node_count(), leaves: self.leaf_count() }
     }
 
     pub fn node_count(&self) -> usize {
@@ -208,7 +216,7 @@ impl Bvh {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::real::Vec3;
+    use super::super::real::Vec3;
 
     fn point_boxes(points: &[Vec3]) -> Vec<Aabb> {
         points

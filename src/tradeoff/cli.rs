@@ -10,7 +10,7 @@ use super::report::significant;
 use super::sweep::{DEFAULT_FILTERS, SweepPlan, filter_name};
 use super::{Tradeoff, TradeoffOptions, run_tradeoff};
 use crate::case::{MAX_BOUNCES, MAX_IMAGE_SIZE, case_name};
-use crate::render::Filter;
+use crate::options::{Filter, Precision};
 
 /// Render a case over a sweep of samples, filters and bounces; measure each setting's time, rays
 /// and error against a converged reference; write tradeoff.csv, tradeoff.md and a log-log plot
@@ -34,6 +34,10 @@ pub struct TradeoffArgs {
     #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_filter,
           default_values = DEFAULT_FILTERS.map(filter_name))]
     pub filters: Vec<Filter>,
+    /// Precisions of the grid: comma-separated, from f32 and f64 (the reference is always f64).
+    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_precision,
+          default_values = Precision::ALL.map(Precision::name))]
+    pub precisions: Vec<Precision>,
     /// Render every setting and the reference at this size instead of the case's (e.g. 64x48):
     /// a quicker sweep.
     #[arg(long, value_name = "WxH", value_parser = parse_size)]
@@ -77,6 +81,7 @@ impl TradeoffArgs {
             plan: SweepPlan {
                 samples: self.samples.clone(),
                 filters: self.filters.clone(),
+                precisions: self.precisions.clone(),
                 max_bounces: self.max_bounces,
                 bounce_threshold: self.bounce_threshold,
                 reference_samples: self.reference_samples,
@@ -153,6 +158,11 @@ fn parse_filter(text: &str) -> Result<Filter, String> {
     }
 }
 
+fn parse_precision(text: &str) -> Result<Precision, String> {
+    let text = text.trim();
+    Precision::ALL.into_iter().find(|p| p.name() == text).ok_or_else(|| format!("`{text}` is not a precision: f32 or f64"))
+}
+
 fn parse_size(text: &str) -> Result<(u32, u32), String> {
     let usage = || format!("`{text}` is not a size: give WIDTHxHEIGHT, e.g. 64x48");
     let (width, height) = text.split_once(['x', 'X', '×']).ok_or_else(usage)?;
@@ -200,6 +210,8 @@ mod tests {
         assert!(parse_size("99999x10").unwrap_err().contains("16384"));
         assert_eq!(parse_filter("gaussian"), Ok(Filter::Gaussian));
         assert!(parse_filter("box").unwrap_err().contains("none or gaussian"));
+        assert_eq!(parse_precision("f64"), Ok(Precision::F64));
+        assert!(parse_precision("f16").unwrap_err().contains("f32 or f64"));
         assert_eq!(parse_flip("0.05"), Ok(0.05));
         assert!(parse_flip("1.5").is_err() && parse_flip("nan").is_err());
         assert!(parse_threshold("-1").is_err() && parse_threshold("inf").is_err());

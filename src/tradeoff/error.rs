@@ -5,9 +5,9 @@
 use std::io;
 use std::path::PathBuf;
 
+use crate::build_error::BuildError;
 use crate::case::CaseError;
 use crate::film::OutputError;
-use crate::scene::BuildError;
 
 #[derive(Debug, thiserror::Error)]
 pub enum TradeoffError {

@@ -11,17 +11,25 @@ use crate::case::{Case, Tolerance};
 use crate::compare::{Image, compare};
 use crate::film::Film;
 use crate::pipeline::render_options;
-use crate::render::{Filter, Progress, RayCounts, render_counting_rays};
-use crate::scene::{Scene, build_scene};
+use crate::options::{Filter, Precision, RenderOptions};
+use crate::precision::{double, single};
+use crate::progress::Progress;
+use crate::stats::RayCounts;
 
 /// A cheap setting is rendered again until its runs add up to the plan's `min_time`, but never
 /// more often than this: a render of a millisecond needs no more to find its fastest run.
 const MAX_RUNS: u32 = 50;
 
-/// Renders settings of one case. The scene is built once: no setting changes it.
+/// The precision the reference is rendered in: the more accurate one, so that an f32 setting's
+/// rounding shows as error rather than being part of the truth.
+pub const REFERENCE_PRECISION: Precision = Precision::F64;
+
+/// Renders settings of one case. The scene is built once in each precision (the reference is
+/// always f64, most settings are the case's f32), since no setting changes it.
 pub struct Renderer<'a> {
     case: &'a Case,
-    scene: Scene,
+    single: single::scene::Scene,
+    double: double::scene::Scene,
 }
 
 /// One setting's film and what it cost.
@@ -42,6 +50,7 @@ pub struct Reference {
     pub film: Film,
     pub samples: u32,
     pub bounces: u32,
+    pub precision: Precision,
     pub seed: u64,
     pub seconds: f64,
     pub rays: RayCounts,
@@ -49,7 +58,19 @@ pub struct Reference {
 
 impl<'a> Renderer<'a> {
     pub fn new(case: &'a Case) -> Result<Renderer<'a>, TradeoffError> {
-        Ok(Renderer { case, scene: build_scene(case)? })
+        Ok(Renderer {
+            case,
+            single: single::scene::build_scene(case)?,
+            double: double::scene::build_scene(case)?,
+        })
+    }
+
+    /// One render of the film `options` describe, in `precision`, with its rays.
+    fn render_once(&self, precision: Precision, options: &RenderOptions) -> (Film, RayCounts) {
+        match precision {
+            Precision::F32 => single::render::render_counting_rays(&self.single, options, &Progress::hidden()),
+            Precision::F64 => double::render::render_counting_rays(&self.double, options, &Progress::hidden()),
+        }
     }
 
     pub fn pixels(&self) -> u64 {
@@ -65,7 +86,7 @@ impl<'a> Renderer<'a> {
         let options = render_options(&setting.apply(self.case));
         let run = || {
             let start = Instant::now();
-            let (film, rays) = render_counting_rays(&self.scene, &options, &Progress::hidden());
+            let (film, rays) = self.render_once(setting.precision, &options);
             (film, rays, start.elapsed())
         };
         let (film, rays, first) = run();
@@ -80,17 +101,18 @@ impl<'a> Renderer<'a> {
     }
 
     /// The pixel-area integral, as nearly as `samples` stratified samples get it (filter none),
-    /// `bounces` deep. Its seed differs from the case's so that its jitter is independent of
+    /// `bounces` deep, in [`REFERENCE_PRECISION`]. Its seed differs from the case's so that its jitter is independent of
     /// every setting's (the sampler hashes the seed, so the next seed is as good as any): with the
     /// same seed a setting's samples would partly repeat the reference's and its error would look
     /// smaller than it is.
     pub fn reference(&self, samples: u32, bounces: u32) -> Reference {
         let seed = self.case.render.seed.wrapping_add(1);
-        let mut case = Setting { samples, filter: Filter::None, bounces }.apply(self.case);
+        let precision = REFERENCE_PRECISION;
+        let mut case = Setting { samples, filter: Filter::None, bounces, precision }.apply(self.case);
         case.render.seed = seed;
         let start = Instant::now();
-        let (film, rays) = render_counting_rays(&self.scene, &render_options(&case), &Progress::hidden());
-        Reference { film, samples, bounces, seed, seconds: start.elapsed().as_secs_f64(), rays }
+        let (film, rays) = self.render_once(precision, &render_options(&case));
+        Reference { film, samples, bounces, precision, seed, seconds: start.elapsed().as_secs_f64(), rays }
     }
 }
 

@@ -93,17 +93,31 @@ fn floor_of(values: impl Iterator<Item = f64>, fallback: f64) -> f64 {
     values.filter(|v| *v > 0.0).fold(None, |low: Option<f64>, v| Some(low.map_or(v, |l| l.min(v)))).map_or(fallback, |v| v / 2.0)
 }
 
-/// The grid's curves (one per filter, labelled by samples per pixel) and the bounce sweep's
-/// (labelled b0, b1, …).
+/// The grid's curves (one per precision and filter, labelled by samples per pixel) and the
+/// bounce sweep's (labelled b0, b1, …).
 fn curves(t: &Tradeoff, floor: (f64, f64)) -> Vec<Curve> {
     let mut curves = Vec::new();
-    let mut filters: Vec<_> = t.measurements.iter().filter(|m| m.in_grid).map(|m| m.setting.filter).collect();
-    filters.dedup();
-    for filter in filters {
-        let mut members: Vec<&Measurement> = t.measurements.iter().filter(|m| m.in_grid && m.setting.filter == filter).collect();
+    let mut kinds: Vec<_> = Vec::new();
+    for m in t.measurements.iter().filter(|m| m.in_grid) {
+        let kind = (m.setting.precision, m.setting.filter);
+        if !kinds.contains(&kind) {
+            kinds.push(kind);
+        }
+    }
+    for (precision, filter) in kinds {
+        let mut members: Vec<&Measurement> = t
+            .measurements
+            .iter()
+            .filter(|m| m.in_grid && m.setting.precision == precision && m.setting.filter == filter)
+            .collect();
         members.sort_by_key(|m| m.setting.samples);
         curves.push(Curve {
-            name: format!("filter {}, {} bounces: samples per pixel", filter_name(filter), t.bounces.enough()),
+            name: format!(
+                "{}, filter {}, {} bounces: samples per pixel",
+                precision.name(),
+                filter_name(filter),
+                t.bounces.enough()
+            ),
             points: members.iter().map(|m| (position(m, t, floor), m.setting.samples.to_string())).collect(),
             dashed: false,
         });
@@ -111,7 +125,13 @@ fn curves(t: &Tradeoff, floor: (f64, f64)) -> Vec<Curve> {
     let mut bounces: Vec<&Measurement> = t.measurements.iter().filter(|m| m.in_bounce_sweep).collect();
     bounces.sort_by_key(|m| m.setting.bounces);
     curves.push(Curve {
-        name: format!("bounces 0…{} at {} spp, filter {}", t.bounces.last, t.base.samples, filter_name(t.base.filter)),
+        name: format!(
+            "{}, bounces 0…{} at {} spp, filter {}",
+            t.base.precision.name(),
+            t.bounces.last,
+            t.base.samples,
+            filter_name(t.base.filter)
+        ),
         points: bounces.iter().map(|m| (position(m, t, floor), format!("b{}", m.setting.bounces))).collect(),
         dashed: true,
     });

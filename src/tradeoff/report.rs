@@ -23,10 +23,11 @@ pub const MARKDOWN_FILE: &str = "tradeoff.md";
 pub const PLOT_FILE: &str = "tradeoff.png";
 
 /// The CSV's columns, one row per setting.
-pub const CSV_COLUMNS: [&str; 14] = [
+pub const CSV_COLUMNS: [&str; 15] = [
     "setting",
     "samples",
     "filter",
+    "precision",
     "bounces",
     "sweep",
     "seconds",
@@ -106,10 +107,11 @@ pub fn csv(tradeoff: &Tradeoff) -> String {
         let s = &m.setting;
         let _ = writeln!(
             out,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             s.label(),
             s.samples,
             filter_name(s.filter),
+            s.precision.name(),
             s.bounces,
             sweeps(m),
             m.seconds,
@@ -134,7 +136,7 @@ pub fn markdown(t: &Tradeoff) -> String {
     let _ = writeln!(
         md,
         "Case `{}` at {}×{} on {}, by {SOFTWARE} {}. Every setting is the case's own except \
-         the samples per pixel, the filter and the bounces shown.\n",
+         the samples per pixel, the filter, the precision and the bounces shown.\n",
         t.case_path.display(),
         t.width,
         t.height,
@@ -144,10 +146,11 @@ pub fn markdown(t: &Tradeoff) -> String {
     let _ = writeln!(
         md,
         "**Reference:** {} stratified samples per pixel with no filter (the pixel-area integral), {}, \
-         seed {}; {} s, {} rays. Errors are against it: RMSE and the largest error on linear colour, FLIP \
+         {}, seed {}; {} s, {} rays. Errors are against it: RMSE and the largest error on linear colour, FLIP \
          (NVIDIA's perceptual difference, 0 = identical) on the sRGB pictures.\n",
         r.samples,
         plural(r.bounces, "bounce"),
+        r.precision.name(),
         r.seed,
         significant(r.seconds),
         grouped(r.rays.total()),
@@ -160,16 +163,19 @@ pub fn markdown(t: &Tradeoff) -> String {
          kind (camera, AOV, shadow, reflection).\n",
         t.min_time.as_secs_f64()
     );
-    md.push_str("| setting | samples | filter | bounces | time (s) | rays | Mrays/s | RMSE | max error | FLIP | Pareto |\n");
-    md.push_str("| --- | ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | :---: |\n");
+    md.push_str(
+        "| setting | samples | filter | precision | bounces | time (s) | rays | Mrays/s | RMSE | max error | FLIP | Pareto |\n",
+    );
+    md.push_str("| --- | ---: | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | :---: |\n");
     for (m, on_front) in t.measurements.iter().zip(&t.pareto) {
         let s = &m.setting;
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             s.label(),
             s.samples,
             filter_name(s.filter),
+            s.precision.name(),
             s.bounces,
             significant(m.seconds),
             grouped(m.rays.total()),
@@ -202,7 +208,12 @@ pub fn markdown(t: &Tradeoff) -> String {
 /// What the bounce sweep found, in one sentence.
 pub fn bounce_sentence(t: &Tradeoff) -> String {
     let b = &t.bounces;
-    let of = format!("at the case's {} spp, filter {}", t.base.samples, filter_name(t.base.filter));
+    let of = format!(
+        "at the case's {} spp, filter {}, {}",
+        t.base.samples,
+        filter_name(t.base.filter),
+        t.base.precision.name()
+    );
     let asks = format!("The case asks for {}.", plural(t.base.bounces, "bounce"));
     match (b.settled, b.last) {
         (true, last) => format!(

@@ -1,5 +1,6 @@
 //! What the sweep renders and in what order: the settings (one value per axis), the bounce
-//! sweep that finds how many bounces the picture needs, and the grid of samples × filter.
+//! sweep that finds how many bounces the picture needs, and the grid of precision × filter ×
+//! samples.
 //!
 //! The bounce sweep runs first because the rest depends on it. The reference must be at least as
 //! deep as anything it judges, and "deep enough" is what the bounce sweep measures: an extra
@@ -15,7 +16,7 @@ use indicatif::ProgressBar;
 use super::error::TradeoffError;
 use super::measure::{Measurement, Reference, Render, Renderer, errors};
 use crate::case::{Case, MAX_BOUNCES, MAX_IMAGE_SIZE};
-use crate::render::Filter;
+use crate::options::{Filter, Precision};
 
 /// One point of the sweep: a value on every axis. Everything else (scene, size, seed, shadows)
 /// is the case's own, so two settings differ only in what the sweep varies.
@@ -25,17 +26,23 @@ pub struct Setting {
     pub samples: u32,
     pub filter: Filter,
     pub bounces: u32,
+    pub precision: Precision,
 }
 
 impl Setting {
     /// The setting the case file itself asks for.
     pub fn of(case: &Case) -> Setting {
-        Setting { samples: case.render.samples, filter: case.render.filter, bounces: case.render.bounces }
+        Setting {
+            samples: case.render.samples,
+            filter: case.render.filter,
+            bounces: case.render.bounces,
+            precision: case.render.precision,
+        }
     }
 
-    /// A short name without commas (it is a CSV field and a plot label): `16spp gaussian 2b`.
+    /// A short name without commas (it is a CSV field and a plot label): `16spp gaussian 2b f32`.
     pub fn label(&self) -> String {
-        format!("{}spp {} {}b", self.samples, filter_name(self.filter), self.bounces)
+        format!("{}spp {} {}b {}", self.samples, filter_name(self.filter), self.bounces, self.precision.name())
     }
 
     /// Camera rays per output pixel: the part of the cost known before rendering, which weighs
@@ -54,6 +61,7 @@ impl Setting {
         case.render.samples = self.samples;
         case.render.filter = self.filter;
         case.render.bounces = self.bounces;
+        case.render.precision = self.precision;
         case
     }
 }
@@ -76,6 +84,8 @@ pub struct SweepPlan {
     pub samples: Vec<u32>,
     /// Filters of the grid, each at most once.
     pub filters: Vec<Filter>,
+    /// Precisions of the grid, each at most once.
+    pub precisions: Vec<Precision>,
     /// The bounce sweep stops here even if the picture is still changing.
     pub max_bounces: u32,
     /// The bounce sweep stops once one more bounce changes no colour channel of any pixel by more
@@ -95,6 +105,7 @@ impl Default for SweepPlan {
         SweepPlan {
             samples: vec![1, 4, 16, 64, 256],
             filters: DEFAULT_FILTERS.to_vec(),
+            precisions: Precision::ALL.to_vec(),
             max_bounces: 16,
             // A thousandth of white: under half an 8-bit code anywhere but the deepest shadows.
             bounce_threshold: 1e-3,
@@ -109,8 +120,8 @@ impl SweepPlan {
     /// Checks what the command line cannot check flag by flag, before anything renders.
     pub fn validate(&self) -> Result<(), TradeoffError> {
         let plan = |message: String| Err(TradeoffError::Plan(message));
-        if self.samples.is_empty() || self.filters.is_empty() {
-            return plan("the sweep needs at least one sample count and one filter".to_owned());
+        if self.samples.is_empty() || self.filters.is_empty() || self.precisions.is_empty() {
+            return plan("the sweep needs at least one sample count, one filter and one precision".to_owned());
         }
         if let Some(&n) = self.samples.iter().find(|&&n| !is_square(n)) {
             return plan(format!("samples {n}: every sample count must be a perfect square (1, 4, 9, 16, …)"));
@@ -137,13 +148,16 @@ impl SweepPlan {
         Ok(())
     }
 
-    /// Every combination of the grid's axes at `bounces`, filter-major then samples ascending, so
-    /// each filter's settings form one curve.
+    /// Every combination of the grid's axes at `bounces`: by precision, then filter, then samples
+    /// as listed, so that each (precision, filter) pair's settings form one curve.
     pub fn grid(&self, bounces: u32) -> Vec<Setting> {
-        self.filters
-            .iter()
-            .flat_map(|&filter| self.samples.iter().map(move |&samples| Setting { samples, filter, bounces }))
-            .collect()
+        let mut grid = Vec::with_capacity(self.precisions.len() * self.filters.len() * self.samples.len());
+        for &precision in &self.precisions {
+            for &filter in &self.filters {
+                grid.extend(self.samples.iter().map(|&samples| Setting { samples, filter, bounces, precision }));
+            }
+        }
+        grid
     }
 }
 
@@ -261,13 +275,19 @@ mod tests {
     }
 
     #[test]
-    fn the_grid_is_every_filter_times_every_sample_count_at_the_given_bounces() {
+    fn the_grid_is_every_precision_filter_and_sample_count_at_the_given_bounces() {
         let grid = plan(&[1, 4], 16).grid(3);
-        let expected = [(1, Filter::None), (4, Filter::None), (1, Filter::Gaussian), (4, Filter::Gaussian)];
-        assert_eq!(grid.len(), expected.len());
-        for (setting, (samples, filter)) in grid.iter().zip(expected) {
-            assert_eq!(*setting, Setting { samples, filter, bounces: 3 });
+        let mut expected = Vec::new();
+        for precision in [Precision::F32, Precision::F64] {
+            for filter in [Filter::None, Filter::Gaussian] {
+                for samples in [1, 4] {
+                    expected.push(Setting { samples, filter, bounces: 3, precision });
+                }
+            }
         }
+        assert_eq!(grid, expected);
+        let single = SweepPlan { precisions: vec![Precision::F64], filters: vec![Filter::None], ..plan(&[9], 16) };
+        assert_eq!(single.grid(0), [Setting { samples: 9, filter: Filter::None, bounces: 0, precision: Precision::F64 }]);
     }
 
     #[test]
@@ -278,6 +298,7 @@ mod tests {
         assert!(message(plan(&[1, 4], 4)).contains("more samples than every setting"));
         assert!(message(plan(&[1], 10)).contains("reference samples 10"));
         assert!(message(plan(&[], 16)).contains("at least one"));
+        assert!(message(SweepPlan { precisions: Vec::new(), ..SweepPlan::default() }).contains("one precision"));
         let deep = SweepPlan { max_bounces: 5000, ..SweepPlan::default() };
         assert!(message(deep).contains("at most 1024"));
         let nan = SweepPlan { bounce_threshold: f64::NAN, ..SweepPlan::default() };
@@ -286,8 +307,8 @@ mod tests {
 
     #[test]
     fn labels_name_every_axis_without_commas() {
-        let setting = Setting { samples: 16, filter: Filter::Gaussian, bounces: 2 };
-        assert_eq!(setting.label(), "16spp gaussian 2b");
+        let setting = Setting { samples: 16, filter: Filter::Gaussian, bounces: 2, precision: Precision::F64 };
+        assert_eq!(setting.label(), "16spp gaussian 2b f64");
         assert_eq!(setting.camera_rays_per_pixel(), 144);
     }
 

@@ -5,8 +5,8 @@
 //! schedules the work.
 
 use super::BvhNode;
-use crate::geometry::aabb::Aabb;
-use crate::real::{Real, Vec3};
+use super::super::aabb::Aabb;
+use super::super::real::{Real, Vec3};
 
 /// Twelve bins find splits within a few percent of a full sweep at a fraction of its cost.
 const BIN_COUNT: usize = 12;
