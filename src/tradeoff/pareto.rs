@@ -1,13 +1,21 @@
 //! Reading the measurements: which settings are worth using at all (the Pareto front), and which
 //! is the cheapest that is good enough.
 
+/// Errors closer than this (relative) are the same error. Settings that render the same picture
+/// in other ways (f32 and f64, or one bounce past where nothing changes) differ in the last
+/// digits of their error, and a slower setting should not reach the front by rounding.
+pub const SAME_ERROR: f64 = 1e-3;
+
 /// For each `(cost, error)` point, whether it is on the Pareto front: no other point is at most
-/// as costly and at most as wrong while strictly better in one of the two. Every setting off
-/// the front has another setting that is faster without being worse, or better without being
-/// slower, so it is never the right choice. Equal points are all on the front (none beats the
-/// other). NaN never dominates and is never on the front.
+/// as costly and at most as wrong while strictly better in one of the two (errors within
+/// [`SAME_ERROR`] of each other counting as equal). Every setting off the front has another that
+/// is faster without being worse, or better without being slower, so it is never the right
+/// choice. Equal points are all on the front (none beats the other). NaN never dominates and is
+/// never on the front.
 pub fn pareto_front(points: &[(f64, f64)]) -> Vec<bool> {
-    let dominates = |(ca, ea): (f64, f64), (cb, eb): (f64, f64)| ca <= cb && ea <= eb && (ca < cb || ea < eb);
+    let dominates = |(ca, ea): (f64, f64), (cb, eb): (f64, f64)| {
+        ca <= cb && ea <= eb * (1.0 + SAME_ERROR) && (ca < cb || ea < eb * (1.0 - SAME_ERROR))
+    };
     points
         .iter()
         .map(|&p| !p.0.is_nan() && !p.1.is_nan() && !points.iter().any(|&q| dominates(q, p)))
@@ -42,6 +50,13 @@ mod tests {
             (0.5, 0.9),  // the very fastest: on
         ];
         assert_eq!(pareto_front(&points), [true, true, false, true, false, false, true, true]);
+    }
+
+    #[test]
+    fn a_slower_setting_is_not_on_the_front_for_an_error_smaller_only_by_rounding() {
+        let points = [(1.0, 0.0245), (1.2, 0.024_499_99), (1.3, 0.0244)];
+        assert_eq!(pareto_front(&points), [true, false, true], "0.4% better is better; 4e-7 is not");
+        assert_eq!(pareto_front(&[(1.0, 0.5), (1.0, 0.500_01)]), [true, true], "as costly and as good: both");
     }
 
     #[test]

@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 use super::Tradeoff;
 use super::error::TradeoffError;
 use super::measure::Measurement;
+use super::pareto::SAME_ERROR;
 use super::plot::{SOFTWARE, is_our_png, plot_png};
 use super::sweep::filter_name;
 use crate::film::write_file_atomic;
@@ -190,9 +191,11 @@ pub fn markdown(t: &Tradeoff) -> String {
     let _ = writeln!(
         md,
         "\n**Pareto front** (★, by {}): the settings no other setting beats in both time and error, fastest \
-         first: {}. Any other setting has one that is at least as fast and at least as accurate.\n",
+         first: {}. Any other setting has one that is at least as fast and at least as accurate (errors within \
+         {}% of each other count as equal).\n",
         t.metric.title(),
-        front.join(", ")
+        front.join(", "),
+        SAME_ERROR * 100.0
     );
     if let Some(sentence) = t.target_sentence() {
         let _ = writeln!(md, "**Target:** {sentence}\n");
