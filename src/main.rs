@@ -79,8 +79,8 @@ enum Command {
     /// Grade folders of student renders against a rubric's golden images: writes grades.csv,
     /// grades.json and an HTML report. Exit code 0 whenever grading ran, whatever the grades.
     Grade(goldray::grade::GradeArgs),
-    /// Measure the speed-accuracy trade: render a case over samples × filter and bounces, time
-    /// each setting and count its rays, measure its error against a converged reference, and
+    /// Measure the speed-accuracy trade: render a case over samples × filter × precision and
+    /// bounces, time each setting and count its rays, measure its error against a converged reference, and
     /// write tradeoff.csv, tradeoff.md and a log-log plot tradeoff.png with the Pareto front.
     Tradeoff(goldray::tradeoff::TradeoffArgs),
 }

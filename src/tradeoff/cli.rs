@@ -12,7 +12,7 @@ use super::{Tradeoff, TradeoffOptions, run_tradeoff};
 use crate::case::{MAX_BOUNCES, MAX_IMAGE_SIZE, case_name};
 use crate::options::{Filter, Precision};
 
-/// Render a case over a sweep of samples, filters and bounces; measure each setting's time, rays
+/// Render a case over a sweep of samples, filters, precisions and bounces; measure each setting's time, rays
 /// and error against a converged reference; write tradeoff.csv, tradeoff.md and a log-log plot
 /// tradeoff.png with the Pareto front marked.
 #[derive(Clone, Debug, clap::Args)]
@@ -26,7 +26,7 @@ pub struct TradeoffArgs {
     /// (0 = identical to the reference, 1 = as different as can be).
     #[arg(long, value_name = "X", value_parser = parse_flip)]
     pub target_flip: Option<f64>,
-    /// Samples per pixel of the grid: comma-separated perfect squares.
+    /// Samples per pixel of the grid: comma-separated perfect squares (e.g. 1,4,16).
     #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_square,
           default_values_t = SweepPlan::default().samples)]
     pub samples: Vec<u32>,

@@ -140,11 +140,12 @@ pub fn errors(reference: &Film, film: &Film, setting: &Setting) -> Result<Errors
 /// Which error the plot and the Pareto front rank settings by.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
 pub enum Metric {
-    /// The usual measure of convergence: its log-log slope against samples is the convergence
-    /// rate (−0.5 for independent random samples, steeper for stratified ones on edges).
+    /// RMSE on linear colour: its log-log slope against samples is the convergence rate
     #[default]
     Rmse,
+    /// The largest error of any colour channel of any pixel
     Max,
+    /// The FLIP mean: what a viewer would notice
     Flip,
 }
 
