@@ -34,5 +34,25 @@ macro_rules! with_precision {
     };
 }
 
+/// Declares one instantiation: the names bound to its types, then the shared source files.
+macro_rules! instantiate {
+    ($real:ty, $vec2:ty, $vec3:ty, $mat3:ty, $mat4:ty) => {
+        pub type Real = $real;
+        pub type Vec2 = $vec2;
+        pub type Vec3 = $vec3;
+        pub type Mat3 = $mat3;
+        pub type Mat4 = $mat4;
+
+        #[path = "../real.rs"]
+        pub mod real;
+        #[path = "../geometry/mod.rs"]
+        pub mod geometry;
+        #[path = "../scene/mod.rs"]
+        pub mod scene;
+        #[path = "../render/mod.rs"]
+        pub mod render;
+    };
+}
+
 pub mod double;
 pub mod single;
