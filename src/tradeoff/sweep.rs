@@ -177,7 +177,6 @@ pub struct BounceOutcome {
     /// bounce 0 was rendered).
     pub last_change: f64,
     pub threshold: f64,
-    pub max_bounces: u32,
 }
 
 impl BounceOutcome {
@@ -203,8 +202,8 @@ pub struct Sweep {
 }
 
 /// Runs the bounce sweep, renders the reference, then the grid at the depth the bounce sweep
-/// found enough, advancing `bar` by each render's
-/// camera rays (its length is the estimate; the bounce sweep adds to it as it goes deeper).
+/// found enough, advancing `bar` by each render's camera rays (its length is the estimate; the
+/// bounce sweep adds to it as it goes deeper).
 pub fn run_sweep(case: &Case, plan: &SweepPlan, bar: &ProgressBar) -> Result<Sweep, TradeoffError> {
     let renderer = Renderer::new(case)?;
     let base = Setting::of(case);
@@ -227,7 +226,6 @@ pub fn run_sweep(case: &Case, plan: &SweepPlan, bar: &ProgressBar) -> Result<Swe
         settled: false,
         last_change: 0.0,
         threshold: plan.bounce_threshold,
-        max_bounces: plan.max_bounces,
     };
     for bounces in 0..=plan.max_bounces {
         if bounces > 0 {
@@ -256,8 +254,8 @@ pub fn run_sweep(case: &Case, plan: &SweepPlan, bar: &ProgressBar) -> Result<Swe
         .collect::<Result<_, _>>()?;
     drop(bounce_renders);
     for setting in grid {
-        if let Some(done) = measurements.iter_mut().find(|m| m.setting == setting) {
-            done.in_grid = true;
+        if measurements.iter().any(|m| m.setting == setting) {
+            // Rendered by the bounce sweep, and already marked as part of the grid.
             bar.inc(cost(&setting));
             continue;
         }
