@@ -8,6 +8,8 @@
 pub mod counter;
 mod table;
 
+pub(crate) use table::grouped;
+
 pub use counter::RayCounts;
 
 use std::path::{Path, PathBuf};

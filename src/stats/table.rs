@@ -85,7 +85,7 @@ fn duration(duration: Duration) -> String {
 }
 
 /// `1234567` → `1,234,567`: ray counts run to billions.
-fn grouped(n: u64) -> String {
+pub(crate) fn grouped(n: u64) -> String {
     let digits = n.to_string();
     let mut out = String::with_capacity(digits.len() + digits.len() / 3);
     for (index, digit) in digits.chars().enumerate() {

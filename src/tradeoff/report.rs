@@ -18,6 +18,7 @@ use super::pareto::SAME_ERROR;
 use super::plot::{SOFTWARE, is_our_png, plot_png};
 use super::sweep::filter_name;
 use crate::film::write_file_atomic;
+use crate::stats::grouped;
 
 pub const CSV_FILE: &str = "tradeoff.csv";
 pub const MARKDOWN_FILE: &str = "tradeoff.md";
@@ -257,19 +258,6 @@ pub fn significant(value: f64) -> String {
     }
 }
 
-/// `1234567` → `1,234,567`.
-pub fn grouped(n: u64) -> String {
-    let digits = n.to_string();
-    let mut out = String::with_capacity(digits.len() + digits.len() / 3);
-    for (i, c) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i).is_multiple_of(3) {
-            out.push(',');
-        }
-        out.push(c);
-    }
-    out
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -281,9 +269,6 @@ mod tests {
         assert_eq!(significant(123.4), "123");
         assert_eq!(significant(0.0), "0");
         assert_eq!(significant(0.00001234), "1.23e-5");
-        assert_eq!(grouped(1_234_567), "1,234,567");
-        assert_eq!(grouped(999), "999");
-        assert_eq!(grouped(0), "0");
     }
 
     #[test]
