@@ -8,7 +8,8 @@
 //! - `bvh_build/blob_1.3M`: the binned-SAH build over that mesh's triangle boxes, on one and two
 //!   threads.
 //! - `only_what_is_required/blob_1.3M/*`: the blob lit by a point light with shadows on and
-//!   off, and unlit: shadows off should cost what no light costs.
+//!   off, and unlit: shadows off should cost what no light costs; and 4 samples per pixel with
+//!   and without the depth and normal AOVs (5 and 4 rays per pixel).
 //! - `end_to_end/*`: load, build and render shipped cases (no file writes).
 //! - `course_scenes/seven_at_800`: the course's seven grading commands at 800×800, one after
 //!   another, each parsed, rendered and its three PNGs encoded, as `goldray mit6837` does.
@@ -18,7 +19,7 @@
 //!   reports rays/s; `on` and `off` should agree within noise.
 
 use std::path::Path;
-use std::sync::Arc;
+use std::sync::{Arc, LazyLock};
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use rayon::prelude::*;
@@ -41,14 +42,27 @@ const SIDE: u32 = 256;
 /// Rays per iteration of the incoherent benchmark: enough that each thread gets many chunks.
 const INCOHERENT_RAYS: usize = 1 << 16;
 
+/// 20·4⁸ triangles: an icosahedron subdivided eight times.
+const BLOB_TRIANGLES: u64 = 1_310_720;
+
+/// The 1,310,720-triangle blob's vertices and triangles, generated on first use.
+static BLOB: LazyLock<(Vec<Vec3>, Vec<[u32; 3]>)> = LazyLock::new(|| blob(8, 1));
+
+/// The blob as a mesh with its BVH, built once and shared by every benchmark that renders it.
+static BLOB_MESH: LazyLock<Arc<Mesh>> = LazyLock::new(|| {
+    let (positions, triangles) = &*BLOB;
+    Arc::new(Mesh::new(positions, triangles, VertexNormals::Averaged).expect("the blob is a valid mesh"))
+});
+
+/// The scenes below are cheap to make once the mesh exists, so each benchmark makes its own
+/// inside its closure: criterion calls only the closures its filter selects, and a filtered run
+/// (`cargo bench -- incoherent`, or one under callgrind) builds nothing it does not measure.
 fn blob_scene() -> Scene {
     blob_scene_lit(Vec::new())
 }
 
 fn blob_scene_lit(lights: Vec<Light>) -> Scene {
-    let (positions, triangles) = blob(8, 1);
-    let mesh = Mesh::new(&positions, &triangles, VertexNormals::Averaged).expect("the blob is a valid mesh");
-    let object = Object { shape: Shape::Mesh(Arc::new(mesh)), transform: None, material: 0 };
+    let object = Object { shape: Shape::Mesh(Arc::clone(&BLOB_MESH)), transform: None, material: 0 };
     Scene {
         camera: Camera::new(Profile::Native, Vec3::new(0.0, 0.0, 2.6), -Vec3::Z, Vec3::Y, 40.0),
         background: Background::Color(Color::ZERO),
@@ -60,7 +74,6 @@ fn blob_scene_lit(lights: Vec<Light>) -> Scene {
 }
 
 fn primary_rays(c: &mut Criterion) {
-    let scene = blob_scene();
     let options = RenderOptions {
         width: SIDE,
         height: SIDE,
@@ -69,6 +82,7 @@ fn primary_rays(c: &mut Criterion) {
         samples: 1,
         seed: 0,
         filter: Filter::None,
+        aovs: true,
     };
     let mut group = c.benchmark_group("primary_rays");
     group.sample_size(10);
@@ -76,6 +90,7 @@ fn primary_rays(c: &mut Criterion) {
     for threads in [1, 2] {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a thread pool");
         group.bench_function(format!("blob_1.3M/{threads}_threads"), |b| {
+            let scene = blob_scene();
             b.iter(|| pool.install(|| render(&scene, &options, &Progress::hidden())))
         });
     }
@@ -106,7 +121,6 @@ fn incoherent_ray(index: u64) -> Ray {
 }
 
 fn incoherent_rays(c: &mut Criterion) {
-    let scene = blob_scene();
     let rays: Vec<Ray> = (0..INCOHERENT_RAYS as u64).map(incoherent_ray).collect();
     let mut group = c.benchmark_group("incoherent_rays");
     group.sample_size(10);
@@ -114,6 +128,7 @@ fn incoherent_rays(c: &mut Criterion) {
     for threads in [1, 2] {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a thread pool");
         group.bench_function(format!("blob_1.3M/{threads}_threads"), |b| {
+            let scene = blob_scene();
             b.iter(|| {
                 pool.install(|| {
                     rays.par_chunks(256)
@@ -127,12 +142,13 @@ fn incoherent_rays(c: &mut Criterion) {
 }
 
 fn bvh_build(c: &mut Criterion) {
-    let (positions, triangles) = blob(8, 1);
-    let bounds: Vec<Aabb> =
-        triangles.iter().map(|corners| Aabb::from_points(corners.map(|i| positions[i as usize]))).collect();
+    let bounds = LazyLock::new(|| {
+        let (positions, triangles) = &*BLOB;
+        triangles.iter().map(|corners| Aabb::from_points(corners.map(|i| positions[i as usize]))).collect::<Vec<_>>()
+    });
     let mut group = c.benchmark_group("bvh_build");
     group.sample_size(10);
-    group.throughput(Throughput::Elements(bounds.len() as u64));
+    group.throughput(Throughput::Elements(BLOB_TRIANGLES));
     for threads in [1, 2] {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a thread pool");
         group.bench_function(format!("blob_1.3M/{threads}_threads"), |b| b.iter(|| pool.install(|| Bvh::build(&bounds))));
@@ -203,9 +219,9 @@ fn course_scenes(c: &mut Criterion) {
 /// `cargo run --release --example blob -- 8 1 cases/bench/assets/blob_1m.obj` writes.
 fn ensure_blob_1m(path: &Path) {
     if !path.exists() {
-        let (positions, triangles) = blob(8, 1);
+        let (positions, triangles) = &*BLOB;
         std::fs::create_dir_all(path.parent().expect("the asset has a directory")).expect("cases/bench/assets is writable");
-        write_obj(path, &positions, &triangles).expect("the blob OBJ is written");
+        write_obj(path, positions, triangles).expect("the blob OBJ is written");
     }
 }
 
@@ -233,29 +249,34 @@ fn stats_overhead(c: &mut Criterion) {
 
 /// Work a scene does not ask for is not done: the blob lit by one point light renders as fast
 /// with shadows off as with no light at all (both trace only camera rays), and with shadows on
-/// pays for one shadow ray per hit.
+/// pays for one shadow ray per hit. With 4 samples per pixel, the AOVs cost one more ray per
+/// pixel (5 instead of 4) when they are written and nothing when they are not.
 fn only_what_is_required(c: &mut Criterion) {
     let light = Light::Point { position: Vec3::new(2.0, 3.0, 5.0), color: Color::ONE, falloff: 0.05 };
-    let options = |shadows| RenderOptions {
+    let options = |shadows, samples, aovs| RenderOptions {
         width: SIDE,
         height: SIDE,
         bounces: 0,
         shadows,
-        samples: 1,
+        samples,
         seed: 0,
         filter: Filter::None,
+        aovs,
     };
     let renders = [
-        ("shadows_on", blob_scene_lit(vec![light]), options(true)),
-        ("shadows_off", blob_scene_lit(vec![light]), options(false)),
-        ("no_lights", blob_scene(), options(false)),
+        ("shadows_on", vec![light], options(true, 1, true)),
+        ("shadows_off", vec![light], options(false, 1, true)),
+        ("no_lights", Vec::new(), options(false, 1, true)),
+        ("4_samples_with_aovs", Vec::new(), options(false, 4, true)),
+        ("4_samples_without_aovs", Vec::new(), options(false, 4, false)),
     ];
     let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("a thread pool");
     let mut group = c.benchmark_group("only_what_is_required");
     group.sample_size(10);
-    for (name, scene, options) in &renders {
+    for (name, lights, options) in &renders {
         group.bench_function(format!("blob_1.3M/{name}"), |b| {
-            b.iter(|| pool.install(|| render(scene, options, &Progress::hidden())))
+            let scene = blob_scene_lit(lights.clone());
+            b.iter(|| pool.install(|| render(&scene, options, &Progress::hidden())))
         });
     }
     group.finish();

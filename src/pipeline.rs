@@ -24,7 +24,8 @@ pub fn render_case(case: &Case, show_progress: bool) -> Result<Film, Error> {
     Ok(render(&scene, &render_options(case), &progress(case, show_progress)))
 }
 
-/// The renderer's options from a case's `[render]` table.
+/// The renderer's options from a case's `[render]` table. A case's render always writes the
+/// EXR, whose `Z` and `N` channels are the AOVs, so they are always traced.
 pub fn render_options(case: &Case) -> RenderOptions {
     let settings = &case.render;
     RenderOptions {
@@ -35,6 +36,7 @@ pub fn render_options(case: &Case) -> RenderOptions {
         samples: settings.samples,
         seed: settings.seed,
         filter: settings.filter,
+        aovs: true,
     }
 }
 
@@ -62,27 +64,35 @@ pub fn render_case_file(
     measured_run(
         || Ok(case::load(path, load)?),
         show_progress,
+        true,
         |case, film| Ok(write_outputs(out_dir, &case.name, film, &output_options(case))?),
     )
 }
 
 /// `goldray mit6837`: renders a course scene file as the course binary would and writes the
-/// files its flags name.
+/// files its flags name; the depth and normal AOVs are traced only when one of them is written.
 pub fn render_assignment(
     scene: &Path,
     options: &AssignmentOptions,
     outputs: &AssignmentOutputs,
     show_progress: bool,
 ) -> Result<Rendered, Error> {
-    measured_run(|| Ok(load_assignment_scene(scene, options)?), show_progress, |_, film| Ok(outputs.write(film)?))
+    measured_run(
+        || Ok(load_assignment_scene(scene, options)?),
+        show_progress,
+        outputs.writes_aovs(),
+        |_, film| Ok(outputs.write(film)?),
+    )
 }
 
-/// Load, build, render and write, timing each phase and counting rays. The commands always
+/// Load, build, render (with the AOVs when `aovs`) and write, timing each phase and counting
+/// rays. The commands always
 /// measure: counting costs nothing measurable (`cargo bench -- stats_overhead`), so `--stats`
 /// only decides whether the numbers are shown, and can never change what is rendered.
 fn measured_run(
     load: impl FnOnce() -> Result<Case, Error>,
     show_progress: bool,
+    aovs: bool,
     write: impl FnOnce(&Case, &Film) -> Result<Vec<PathBuf>, Error>,
 ) -> Result<Rendered, Error> {
     let start = Instant::now();
@@ -91,7 +101,8 @@ fn measured_run(
     let (scene, build_stats) = build_scene_measured(&case)?;
     let build = start.elapsed() - parse;
     let render_start = Instant::now();
-    let (film, rays) = render_counting_rays(&scene, &render_options(&case), &progress(&case, show_progress));
+    let options = RenderOptions { aovs, ..render_options(&case) };
+    let (film, rays) = render_counting_rays(&scene, &options, &progress(&case, show_progress));
     let render = render_start.elapsed();
     // Freed before the outputs are encoded, as `render_case` does, so measuring adds no memory.
     drop(scene);

@@ -28,6 +28,9 @@ pub struct RenderOptions {
     pub samples: u32,
     pub seed: u64,
     pub filter: Filter,
+    /// Whether anything reads the depth and normal AOVs. Without them no ray is traced for
+    /// them and the film's `depth` and `normal` stay as [`Film::new`] made them: all misses.
+    pub aovs: bool,
 }
 
 /// Renders the scene without counting anything.
@@ -104,7 +107,7 @@ impl PixelRenderer<'_> {
             Filter::None if self.sampler.samples_per_pixel() == 1 => {
                 rays.camera += 1;
                 let (color, first) = self.integrator.trace(self.scene.camera.ray(centre, width, height), rays);
-                Pixel::new(color, first.as_ref())
+                Pixel::new(color, first.filter(|_| self.options.aovs).as_ref())
             }
             Filter::None => {
                 let color = self.samples(x, y, width, height, rays);
@@ -136,8 +139,11 @@ impl PixelRenderer<'_> {
     }
 
     /// The AOVs come from one ray through the output pixel's centre: depth and normals averaged
-    /// across an edge would describe no surface at all.
+    /// across an edge would describe no surface at all. Traced only when the AOVs are wanted.
     fn first_hit(&self, centre: Vec2, rays: &mut RayCounts) -> Option<Intersection> {
+        if !self.options.aovs {
+            return None;
+        }
         rays.aov += 1;
         let ray = self.scene.camera.ray(centre, self.options.width, self.options.height);
         self.scene.geometry.intersect(&ray)

@@ -144,16 +144,25 @@ fn the_course_command_takes_the_stats_flags_too() {
     .unwrap();
     let json_path = dir.path().join("stats.json");
     let png = dir.path().join("out.png");
-    let result = goldray(&[
-        "mit6837", "-input", scene.to_str().unwrap(), "-output", png.to_str().unwrap(), "-size", "10", "10", "-shadows", "-jitter",
-        "-stats", "-stats-json", json_path.to_str().unwrap(), "--quiet",
-    ]);
-    assert!(result.status.success(), "{}", stderr(&result));
-    assert!(stderr(&result).contains("Statistics for two_lights (10×10"), "{}", stderr(&result));
-    let json = read_json(&json_path);
-    assert_eq!((count(&json, "camera"), count(&json, "aov")), (1600, 100), "16 jittered samples per pixel");
+    let normals = dir.path().join("normals.png");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "mit6837", "-input", scene.to_str().unwrap(), "-output", png.to_str().unwrap(), "-size", "10", "10", "-shadows",
+            "-jitter", "-stats", "-stats-json", json_path.to_str().unwrap(), "--quiet",
+        ];
+        args.extend_from_slice(extra);
+        let result = goldray(&args);
+        assert!(result.status.success(), "{}", stderr(&result));
+        assert!(stderr(&result).contains("Statistics for two_lights (10×10"), "{}", stderr(&result));
+        read_json(&json_path)
+    };
+    let json = run(&[]);
+    assert_eq!((count(&json, "camera"), count(&json, "aov")), (1600, 0), "16 jittered samples per pixel, no AOV written");
     let shadow = count(&json, "shadow");
     assert!(shadow > 0 && shadow.is_multiple_of(2), "two shadow rays per hit: {shadow}");
+    let json = run(&["-normals", normals.to_str().unwrap()]);
+    assert_eq!((count(&json, "camera"), count(&json, "aov")), (1600, 100), "the normals image needs the AOV rays");
+    assert_eq!(count(&json, "shadow"), shadow);
 }
 
 #[test]
