@@ -35,7 +35,9 @@ use goldray::real::{Color, Real, Vec3};
 use goldray::render::camera::Camera;
 use goldray::render::light::Light;
 use goldray::render::material::Material;
-use goldray::render::{Filter, Profile, Progress, RenderOptions, render, render_counting_rays};
+use goldray::options::{Filter, Profile, RenderOptions, Spawn};
+use goldray::progress::Progress;
+use goldray::render::{render, render_counting_rays};
 use goldray::scene::{Aggregate, Background, Object, Scene, Shape, build_scene};
 
 const SIDE: u32 = 256;
@@ -82,6 +84,7 @@ fn primary_rays(c: &mut Criterion) {
         samples: 1,
         seed: 0,
         filter: Filter::None,
+        spawn: Spawn::ErrorBounds,
         aovs: true,
     };
     let mut group = c.benchmark_group("primary_rays");
@@ -261,6 +264,7 @@ fn only_what_is_required(c: &mut Criterion) {
         samples,
         seed: 0,
         filter: Filter::None,
+        spawn: Spawn::ErrorBounds,
         aovs,
     };
     let renders = [

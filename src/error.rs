@@ -2,7 +2,7 @@
 
 use crate::case::CaseError;
 use crate::film::OutputError;
-use crate::scene::BuildError;
+use crate::build_error::BuildError;
 
 #[derive(Debug, thiserror::Error)]
 pub enum Error {

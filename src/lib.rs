@@ -1,18 +1,22 @@
 //! goldray: a deterministic Whitted-style ray tracer and a scene-to-image regression harness.
 //!
 //! Data flows one way: case → scene → render → film → outputs → compare → grade.
+//!
+//! Geometry, scenes and shading are compiled in both precisions (see [`precision`]); the
+//! single-precision ones, the default, are also reachable at the crate root.
 
 pub mod assignment_outputs;
+pub mod build_error;
 pub mod case;
 pub mod compare;
 pub mod error;
 pub mod film;
-pub mod geometry;
 pub mod grade;
+pub mod options;
 pub mod pipeline;
-pub mod real;
-pub mod render;
-pub mod scene;
+pub mod precision;
+pub mod progress;
 pub mod stats;
 
 pub use error::Error;
+pub use precision::single::{geometry, real, render, scene};

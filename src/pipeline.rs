@@ -1,15 +1,16 @@
 //! The whole path from a case file to files on disk, as the `render` command runs it.
 
 use std::path::{Path, PathBuf};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use crate::assignment_outputs::AssignmentOutputs;
 use crate::case::{self, AssignmentOptions, Case, LoadOptions, case_to_toml, load_assignment_scene};
 use crate::error::Error;
 use crate::film::{Film, OutputOptions, write_outputs};
-use crate::render::{Progress, RenderOptions, render, render_counting_rays};
-use crate::scene::{build_scene, build_scene_measured};
-use crate::stats::{Phases, RenderStats};
+use crate::options::{RenderOptions, Spawn};
+use crate::progress::Progress;
+use crate::stats::{BuildStats, Phases, RayCounts, RenderStats};
+use crate::with_precision;
 
 /// What a command wrote, and the statistics of the render behind it.
 #[derive(Debug)]
@@ -18,10 +19,37 @@ pub struct Rendered {
     pub stats: RenderStats,
 }
 
-/// Renders a loaded case to a film, showing progress when asked.
+/// Renders a loaded case to a film, in the precision it asks for, showing progress when asked.
 pub fn render_case(case: &Case, show_progress: bool) -> Result<Film, Error> {
-    let scene = build_scene(case)?;
-    Ok(render(&scene, &render_options(case), &progress(case, show_progress)))
+    with_precision!(case.render.precision, p => {
+        let scene = p::scene::build_scene(case)?;
+        Ok(p::render::render(&scene, &render_options(case), &progress(case, show_progress)))
+    })
+}
+
+/// [`render_case`], also counting rays and measuring the scene build (for `--stats`), with the
+/// depth and normal AOVs only when `aovs`. The scene is freed before this returns, so measuring
+/// adds no memory to what follows.
+pub fn render_case_measured(case: &Case, show_progress: bool, aovs: bool) -> Result<MeasuredRender, Error> {
+    with_precision!(case.render.precision, p => {
+        let start = Instant::now();
+        let (scene, build_stats) = p::scene::build_scene_measured(case)?;
+        let build_time = start.elapsed();
+        let render_start = Instant::now();
+        let options = RenderOptions { aovs, ..render_options(case) };
+        let (film, rays) = p::render::render_counting_rays(&scene, &options, &progress(case, show_progress));
+        Ok(MeasuredRender { film, rays, build_stats, build_time, render_time: render_start.elapsed() })
+    })
+}
+
+/// What [`render_case_measured`] returns.
+#[derive(Debug)]
+pub struct MeasuredRender {
+    pub film: Film,
+    pub rays: RayCounts,
+    pub build_stats: BuildStats,
+    pub build_time: Duration,
+    pub render_time: Duration,
 }
 
 /// The renderer's options from a case's `[render]` table. A case's render always writes the
@@ -36,6 +64,7 @@ pub fn render_options(case: &Case) -> RenderOptions {
         samples: settings.samples,
         seed: settings.seed,
         filter: settings.filter,
+        spawn: Spawn::ErrorBounds,
         aovs: true,
     }
 }
@@ -86,9 +115,9 @@ pub fn render_assignment(
 }
 
 /// Load, build, render (with the AOVs when `aovs`) and write, timing each phase and counting
-/// rays. The commands always
-/// measure: counting costs nothing measurable (`cargo bench -- stats_overhead`), so `--stats`
-/// only decides whether the numbers are shown, and can never change what is rendered.
+/// rays. The commands always measure: counting costs nothing measurable (`cargo bench --
+/// stats_overhead`), so `--stats` only decides whether the numbers are shown, and can never
+/// change what is rendered.
 fn measured_run(
     load: impl FnOnce() -> Result<Case, Error>,
     show_progress: bool,
@@ -98,18 +127,17 @@ fn measured_run(
     let start = Instant::now();
     let case = load()?;
     let parse = start.elapsed();
-    let (scene, build_stats) = build_scene_measured(&case)?;
-    let build = start.elapsed() - parse;
-    let render_start = Instant::now();
-    let options = RenderOptions { aovs, ..render_options(&case) };
-    let (film, rays) = render_counting_rays(&scene, &options, &progress(&case, show_progress));
-    let render = render_start.elapsed();
-    // Freed before the outputs are encoded, as `render_case` does, so measuring adds no memory.
-    drop(scene);
+    let measured = render_case_measured(&case, show_progress, aovs)?;
     let write_start = Instant::now();
-    let written = write(&case, &film)?;
-    let phases = Phases { parse, build, render, write: write_start.elapsed(), total: start.elapsed() };
-    let stats = RenderStats::new(&case, phases, build_stats, &rays, rayon::current_num_threads());
+    let written = write(&case, &measured.film)?;
+    let phases = Phases {
+        parse,
+        build: measured.build_time,
+        render: measured.render_time,
+        write: write_start.elapsed(),
+        total: start.elapsed(),
+    };
+    let stats = RenderStats::new(&case, phases, measured.build_stats, &measured.rays, rayon::current_num_threads());
     Ok(Rendered { written, stats })
 }
 

@@ -1,14 +1,10 @@
-//! The one place that names the scalar type of geometry and shading.
+//! The scalar of geometry and shading, and the conversions into and out of it.
 //!
-//! Everything that intersects or shades uses these aliases, so that a double-precision mode can
-//! swap them (or make them generic) without touching the algorithms. Film storage stays `f32`
-//! because that is what the EXR and PNG outputs hold.
+//! This file is compiled once per precision (see `crate::precision`): `Real` and the glam
+//! types are whatever the enclosing instantiation names, and everything here is written against
+//! those names only. Film storage stays `f32` because that is what the EXR and PNG outputs hold.
 
-pub type Real = f32;
-pub type Vec3 = glam::Vec3;
-pub type Vec2 = glam::Vec2;
-pub type Mat3 = glam::Mat3;
-pub type Mat4 = glam::Mat4;
+pub use super::{Mat3, Mat4, Real, Vec2, Vec3};
 
 /// Linear RGB radiance, in the same precision as shading.
 pub type Color = Vec3;
@@ -39,12 +35,11 @@ pub fn vec3(v: [f64; 3]) -> Vec3 {
 /// Converts a transform composed in `f64` (as the case loader does) to the shading precision.
 #[inline]
 pub fn mat4(m: glam::DMat4) -> Mat4 {
-    m.as_mat4()
+    Mat4::from_cols_array(&m.to_cols_array().map(real))
 }
 
-/// Narrows a shading value to the film's `f32`; a no-op in the default precision.
+/// Narrows a shading value to the film's `f32`; a no-op in single precision.
 #[inline]
-#[allow(clippy::unnecessary_cast)]
 pub fn to_f32(x: Real) -> f32 {
     x as f32
 }

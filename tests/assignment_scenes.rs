@@ -20,7 +20,7 @@ use goldray::case::{
     TransformOp, composite_matrix, load_assignment_scene, parse_assignment_scene,
 };
 use goldray::film::Tonemap;
-use goldray::render::{Filter, Profile};
+use goldray::options::{Filter, Profile};
 
 const SCENES: [&str; 7] = [
     "scene01_plane.txt",

@@ -8,7 +8,8 @@ use goldray::film::Film;
 use goldray::geometry::Ray;
 use goldray::pipeline::render_case;
 use goldray::real::{Color, Real, Vec3};
-use goldray::render::{Profile, RayCounts};
+use goldray::options::{Profile, Spawn};
+use goldray::stats::RayCounts;
 use goldray::render::camera::Camera;
 use goldray::render::integrator::Whitted;
 use goldray::render::light::Light;
@@ -243,7 +244,7 @@ proptest! {
             materials,
             geometry: Aggregate::new(objects, vec![(Plane::new(Vec3::Y, -3.0), 0)]),
         };
-        let integrator = Whitted::new(&scene, 8, true);
+        let integrator = Whitted::new(&scene, 8, true, Spawn::ErrorBounds);
         let mut counts = RayCounts::default();
         for (origin, direction) in rays {
             let (color, _) = integrator.trace(Ray::new(origin, direction), &mut counts);

@@ -11,7 +11,9 @@ use std::path::Path;
 use goldray::case::{Case, LoadOptions, parse};
 use goldray::film::Film;
 use goldray::pipeline::render_options;
-use goldray::render::{Progress, RayCounts, render, render_counting_rays};
+use goldray::progress::Progress;
+use goldray::render::{render, render_counting_rays};
+use goldray::stats::RayCounts;
 use goldray::scene::build_scene;
 
 const CAMERA: &str = "[camera]\ncenter = [0, 0, 10]\ndirection = [0, 0, -1]\nup = [0, 1, 0]\nfov = 30\n";

@@ -21,7 +21,7 @@ use super::spec::{BackgroundSpec, Case, MaterialSpec};
 use super::value::has_usable_length;
 use super::RenderSettings;
 use crate::film::Tonemap;
-use crate::render::{Filter, Profile};
+use crate::options::{Filter, Precision, Profile};
 
 /// The course binary's command-line flags that shape a render (`-size`, `-bounces`, `-shadows`,
 /// `-jitter`, `-filter`, `-depth`, `-normals`).
@@ -183,6 +183,7 @@ fn render_settings(path: &Path, o: &AssignmentOptions) -> Result<RenderSettings>
         normals: o.normals,
         tonemap: Tonemap::Clamp,
         profile: Profile::Mit6837,
+        precision: Precision::F32,
     })
 }
 

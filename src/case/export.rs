@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use super::spec::{BackgroundSpec, Case, LightSpec, ObjectSpec, ShapeSpec, TransformOp};
 use super::{LoadOptions, parse};
 use crate::film::Tonemap;
-use crate::render::{Filter, Profile};
+use crate::options::{Filter, Profile};
 
 /// `toml_path` is where the file will live: asset paths are written relative to its directory
 /// (or absolute when the two share nothing but the root), as the loader resolves them.
@@ -128,6 +128,11 @@ impl Writer<'_> {
                 "tonemap",
                 r.tonemap != d.tonemap,
                 string(tonemap_name(r.tonemap)),
+            ),
+            (
+                "precision",
+                r.precision != d.precision,
+                string(r.precision.name()),
             ),
         ]);
         out

@@ -9,7 +9,7 @@ use super::error::CaseError;
 use super::spec::{BackgroundSpec, CameraSpec, LightSpec, MaterialSpec, RenderSettings, Tolerance};
 use super::value::{Doc, Field, Result, Table};
 use crate::film::Tonemap;
-use crate::render::Profile;
+use crate::options::Profile;
 
 /// Beyond this a typo (an extra digit) is likelier than intent, and the film would need
 /// gigabytes; `--force` lifts it.
@@ -41,6 +41,7 @@ pub(crate) fn render<'a>(doc: &'a Doc<'a>, field: Option<Field<'a, '_>>) -> Resu
         "normals",
         "tonemap",
         "profile",
+        "precision",
     ])?;
     let (width, height) = t.read("size", (200, 200), |f| size(doc, f))?;
     let profile = t.read("profile", Profile::Native, Field::variant)?;
@@ -74,6 +75,7 @@ pub(crate) fn render<'a>(doc: &'a Doc<'a>, field: Option<Field<'a, '_>>) -> Resu
         normals: t.read("normals", false, Field::boolean)?,
         tonemap: t.read("tonemap", default_tonemap, Field::variant)?,
         profile,
+        precision: t.read("precision", Default::default(), Field::variant)?,
     })
 }
 

@@ -7,7 +7,7 @@ use glam::{DMat4, DVec3};
 
 use super::error::SourceLocation;
 use crate::film::Tonemap;
-use crate::render::{Filter, Profile};
+use crate::options::{Filter, Precision, Profile};
 
 /// One case file: a scene, how to render it, and how far it may drift from its golden image.
 #[derive(Clone, Debug, PartialEq)]
@@ -41,6 +41,7 @@ pub struct RenderSettings {
     pub normals: bool,
     pub tonemap: Tonemap,
     pub profile: Profile,
+    pub precision: Precision,
 }
 
 /// How far a render may drift from golden; all values are non-negative.

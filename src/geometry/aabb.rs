@@ -1,7 +1,7 @@
 //! Axis-aligned bounding boxes and the conservative ray–slab test that BVH traversal relies on.
 
-use crate::geometry::Ray;
-use crate::real::{Real, Vec3, gamma};
+use super::Ray;
+use super::real::{Real, Vec3, gamma};
 
 /// An axis-aligned box, closed on all sides.
 ///

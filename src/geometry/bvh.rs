@@ -7,11 +7,14 @@
 mod build;
 mod collapse;
 
+use std::time::Duration;
+
 use smallvec::SmallVec;
 
-use crate::geometry::Ray;
-use crate::geometry::aabb::{Aabb, SlabRay, hit_lanes};
-use crate::real::Real;
+use super::Ray;
+use super::aabb::{Aabb, SlabRay, hit_lanes};
+use super::real::Real;
+use crate::stats::BvhStats;
 
 /// Children per node: four boxes are tested at once, one per SIMD lane.
 const WIDTH: usize = 4;
@@ -126,6 +129,11 @@ impl Bvh {
     /// The original primitive indices in leaf order.
     pub fn prim_indices(&self) -> &[u32] {
         &self.prim_indices
+    }
+
+    /// Its shape for `--stats`.
+    pub fn stats(&self, build_time: Duration) -> BvhStats {
+        BvhStats { build_time, primitives: self.prim_indices().len(), nodes: self.node_count(), leaves: self.leaf_count() }
     }
 
     /// Number of (4-wide) nodes.
@@ -246,7 +254,7 @@ impl Bvh {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::real::Vec3;
+    use super::super::real::Vec3;
 
     fn point_boxes(points: &[Vec3]) -> Vec<Aabb> {
         points

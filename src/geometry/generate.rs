@@ -6,7 +6,7 @@ use std::path::Path;
 
 use glam::DVec3;
 
-use crate::real::{Real, Vec3};
+use super::real::{Real, Vec3};
 
 /// Smooth bumps that make the blob irregular; more would only cost time.
 const BUMP_COUNT: u64 = 16;

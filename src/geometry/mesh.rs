@@ -1,63 +1,16 @@
 //! Triangle meshes with their own BVH, built once and shared (behind an `Arc`) by every
 //! instance that places the mesh in a scene.
 
-use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use crate::geometry::aabb::Aabb;
-use crate::geometry::bvh::Bvh;
-use crate::geometry::triangle::{
+use super::aabb::Aabb;
+use super::bvh::Bvh;
+use super::triangle::{
     TriangleHit, TriangleRay, face_normal, intersect_triangle, normalize, triangle_surface,
 };
-use crate::geometry::{Ray, SurfaceHit};
-use crate::real::{Real, Vec3};
-
-#[derive(Debug, thiserror::Error)]
-pub enum MeshError {
-    #[error("the mesh has no triangles")]
-    NoTriangles,
-    #[error("{count} triangles or vertices are more than 32-bit indices can address")]
-    TooLarge { count: usize },
-    #[error("vertex {vertex} has a non-finite coordinate: {position}")]
-    NonFinitePosition { vertex: usize, position: Vec3 },
-    #[error("triangle {triangle} uses vertex {index}, but there are only {vertex_count} vertices")]
-    VertexIndexOutOfRange {
-        triangle: usize,
-        index: u32,
-        vertex_count: usize,
-    },
-    #[error("{found} triangles of normal indices were given for {expected} triangles")]
-    NormalTriangleCount { expected: usize, found: usize },
-    #[error("triangle {triangle} uses normal {index}, but there are only {normal_count} normals")]
-    NormalIndexOutOfRange {
-        triangle: usize,
-        index: u32,
-        normal_count: usize,
-    },
-    #[error("cannot read {}: {source}", path.display())]
-    Read {
-        path: PathBuf,
-        source: std::io::Error,
-    },
-    #[error("{}:{line}: {problem}", path.display())]
-    Malformed {
-        path: PathBuf,
-        line: usize,
-        problem: String,
-    },
-    #[error("{}: the file has no faces", path.display())]
-    NoFaces { path: PathBuf },
-    #[error("{}: the OBJ reader failed: {source}", path.display())]
-    Obj {
-        path: PathBuf,
-        source: tobj::LoadError,
-    },
-    #[error("{}: {source}", path.display())]
-    InFile {
-        path: PathBuf,
-        source: Box<MeshError>,
-    },
-}
+use super::{Ray, SurfaceHit};
+use super::real::{Real, Vec3};
+pub use crate::build_error::MeshError;
 
 /// The vertex normals a mesh is built with.
 #[derive(Clone, Debug)]
@@ -238,7 +191,7 @@ fn validate(positions: &[Vec3], triangles: &[[u32; 3]]) -> Result<(), MeshError>
     if let Some(vertex) = positions.iter().position(|p| !p.is_finite()) {
         return Err(MeshError::NonFinitePosition {
             vertex,
-            position: positions[vertex],
+            position: positions[vertex].to_array().map(f64::from),
         });
     }
     for (triangle, corners) in triangles.iter().enumerate() {

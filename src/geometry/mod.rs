@@ -13,3 +13,5 @@ pub mod transform;
 pub mod triangle;
 
 pub use ray::{Ray, SurfaceHit};
+
+use super::real;

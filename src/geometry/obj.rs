@@ -15,8 +15,8 @@
 use std::fmt::Write;
 use std::path::Path;
 
-use crate::geometry::mesh::{Mesh, MeshError, NormalSource, VertexNormals};
-use crate::real::{Real, Vec3};
+use super::mesh::{Mesh, MeshError, NormalSource, VertexNormals};
+use super::real::{Real, Vec3};
 
 impl Mesh {
     /// Loads an OBJ file, merging all of its objects and groups into one mesh and triangulating

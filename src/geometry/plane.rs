@@ -2,7 +2,7 @@
 //! the BVH.
 
 use super::ray::{Ray, SurfaceHit};
-use crate::real::{Real, Vec3, gamma};
+use super::real::{Real, Vec3, gamma};
 
 #[derive(Clone, Copy, Debug)]
 pub struct Plane {

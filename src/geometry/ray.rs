@@ -1,4 +1,4 @@
-use crate::real::{Real, Vec3};
+use super::real::{Real, Vec3};
 
 /// A ray `origin + t·direction`. The direction is not required to be unit length: instancing
 /// keeps the world-space parameter `t` by transforming the direction without renormalising it,

@@ -3,7 +3,8 @@
 //! (pbrt-v4 `OffsetRayOrigin`).
 
 use super::ray::{Ray, SurfaceHit};
-use crate::real::{Real, Vec3};
+use super::real::{Real, Vec3, real};
+use crate::options::Spawn;
 
 /// Shadow rays to a point stop this fraction short of it, so that a light sitting on a surface
 /// is not shadowed by that surface. Relative, so it scales with the scene.
@@ -41,6 +42,26 @@ pub fn spawn_ray_to(hit: &SurfaceHit, target: Vec3) -> (Ray, Real) {
     (Ray::new(origin, target - origin), 1.0 - SHADOW_RAY_SHORTFALL)
 }
 
+/// A ray leaving `hit` towards `direction`, under `policy`.
+pub fn spawn(policy: Spawn, hit: &SurfaceHit, direction: Vec3) -> Ray {
+    match policy {
+        Spawn::ErrorBounds => spawn_ray(hit, direction),
+        Spawn::FixedEpsilon(epsilon) => Ray::new(hit.point + direction.normalize() * real(epsilon), direction),
+    }
+}
+
+/// [`spawn_ray_to`] under `policy`: a fixed epsilon skips that distance at both ends.
+pub fn spawn_to(policy: Spawn, hit: &SurfaceHit, target: Vec3) -> (Ray, Real) {
+    match policy {
+        Spawn::ErrorBounds => spawn_ray_to(hit, target),
+        Spawn::FixedEpsilon(epsilon) => {
+            let to_target = target - hit.point;
+            let skipped = real(epsilon) / to_target.length();
+            (Ray::new(hit.point + to_target * skipped, to_target), 1.0 - 2.0 * skipped)
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -61,7 +82,7 @@ mod tests {
 
     #[test]
     fn an_offset_lost_to_rounding_still_moves_one_ulp() {
-        let hit = hit_at(Vec3::new(0.0, 1.0, 0.0), Vec3::splat(1.0e-12));
+        let hit = hit_at(Vec3::new(0.0, 1.0, 0.0), Vec3::splat(Real::EPSILON * 1.0e-4));
         let ray = spawn_ray(&hit, Vec3::Y);
         assert_eq!(ray.origin.y, (1.0 as Real).next_up());
     }

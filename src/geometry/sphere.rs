@@ -3,7 +3,7 @@
 
 use super::aabb::Aabb;
 use super::ray::{Ray, SurfaceHit};
-use crate::real::{Real, Vec3, gamma};
+use super::real::{Real, Vec3, gamma};
 
 #[derive(Clone, Copy, Debug)]
 pub struct Sphere {

@@ -9,8 +9,8 @@
 
 use glam::Vec3Swizzles;
 
-use crate::geometry::{Ray, SurfaceHit};
-use crate::real::{Real, Vec3, gamma};
+use super::{Ray, SurfaceHit};
+use super::real::{Real, Vec3, gamma};
 
 /// The per-ray part of the test: which axis becomes z, and the shear that makes the ray
 /// direction (0, 0, 1). Computing it once per ray saves that work for every triangle tested.
@@ -121,12 +121,19 @@ pub fn intersect_triangle(
     let inv_det = 1.0 / det;
     let t = t_scaled * inv_det;
 
+    // pbrt's bounds, with one correction: the shear's x and y terms are bounded by the
+    // *unscaled* z (|shear.x|, |shear.y| ≤ 1), while t uses z scaled by 1/d.z. pbrt uses the
+    // scaled z for both, which is the same for its unit-length rays, but an instance's object-
+    // space ray has length 1/scale: the bound then grew with the instance's scale until it
+    // rejected every hit on a mesh scaled by 3000, and shrank below the true error for meshes
+    // scaled down.
     let max_zt = z.abs().max_element();
+    let max_unscaled_zt = Vec3::new(p0t.z, p1t.z, p2t.z).abs().max_element();
     let max_xt = Vec3::new(p0t.x, p1t.x, p2t.x).abs().max_element();
     let max_yt = Vec3::new(p0t.y, p1t.y, p2t.y).abs().max_element();
     let delta_z = gamma(3) * max_zt;
-    let delta_x = gamma(5) * (max_xt + max_zt);
-    let delta_y = gamma(5) * (max_yt + max_zt);
+    let delta_x = gamma(5) * (max_xt + max_unscaled_zt);
+    let delta_y = gamma(5) * (max_yt + max_unscaled_zt);
     let delta_e = 2.0 * (gamma(2) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
     let max_e = Vec3::new(e0, e1, e2).abs().max_element();
     let delta_t =

@@ -1,8 +1,8 @@
 //! Perspective cameras: the native one, and the course reference renderer's, quirks included.
 
-use super::Profile;
-use crate::geometry::Ray;
-use crate::real::{Real, Vec2, Vec3};
+use super::geometry::Ray;
+use super::real::{Real, Vec2, Vec3};
+use crate::options::Profile;
 
 #[derive(Clone, Debug)]
 pub struct Camera {

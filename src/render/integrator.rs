@@ -2,21 +2,23 @@
 //! ray, so the "recursion" is a loop that carries the product of specular colours. That makes
 //! `bounces = 64` (or 1024) cost nothing on the stack.
 
-use super::counter::RayCounts;
-use crate::geometry::Ray;
-use crate::geometry::spawn::{spawn_ray, spawn_ray_to};
-use crate::real::{Color, Real, Vec3};
-use crate::scene::{Intersection, Scene};
+use super::geometry::Ray;
+use super::geometry::spawn::{spawn, spawn_to};
+use super::real::{Color, Real, Vec3};
+use super::scene::{Intersection, Scene};
+use crate::options::Spawn;
+use crate::stats::RayCounts;
 
 pub struct Whitted<'a> {
     scene: &'a Scene,
     bounces: u32,
     shadows: bool,
+    spawn: Spawn,
 }
 
 impl<'a> Whitted<'a> {
-    pub fn new(scene: &'a Scene, bounces: u32, shadows: bool) -> Self {
-        Whitted { scene, bounces, shadows }
+    pub fn new(scene: &'a Scene, bounces: u32, shadows: bool, spawn: Spawn) -> Self {
+        Whitted { scene, bounces, shadows, spawn }
     }
 
     /// The colour seen along a primary ray, and what that ray hit first (for the AOVs). The
@@ -44,7 +46,7 @@ impl<'a> Whitted<'a> {
             let normal = hit.surface.shading_normal;
             let incoming = ray.direction.normalize();
             let reflected = incoming - 2.0 * incoming.dot(normal) * normal;
-            ray = spawn_ray(&hit.surface, reflected);
+            ray = spawn(self.spawn, &hit.surface, reflected);
             rays.reflection += 1;
         }
         (color, first)
@@ -72,8 +74,8 @@ impl<'a> Whitted<'a> {
 
     fn blocked(&self, hit: &Intersection, to_light: Vec3, position: Option<Vec3>) -> bool {
         let (shadow_ray, t_max) = match position {
-            Some(position) => spawn_ray_to(&hit.surface, position),
-            None => (spawn_ray(&hit.surface, to_light), Real::INFINITY),
+            Some(position) => spawn_to(self.spawn, &hit.surface, position),
+            None => (spawn(self.spawn, &hit.surface, to_light), Real::INFINITY),
         };
         self.scene.geometry.occluded(&shadow_ray, t_max)
     }

@@ -1,6 +1,6 @@
 //! Point and directional lights.
 
-use crate::real::{Color, Real, Vec3};
+use super::real::{Color, Real, Vec3};
 
 #[derive(Clone, Copy, Debug)]
 pub enum Light {

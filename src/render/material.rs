@@ -1,6 +1,6 @@
 //! The assignment's Phong material.
 
-use crate::real::{Color, Real, Vec3};
+use super::real::{Color, Real, Vec3};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Material {

@@ -3,14 +3,14 @@
 
 use rayon::prelude::*;
 
-use super::Filter;
-use super::counter::{NoCount, RayCounter, RayCounts};
 use super::integrator::Whitted;
-use super::progress::Progress;
+use super::real::{Color, Real, Vec2, Vec3, to_f32};
 use super::sampler::Sampler;
+use super::scene::{Intersection, Scene};
 use crate::film::Film;
-use crate::real::{Color, Real, Vec2, Vec3, to_f32};
-use crate::scene::{Intersection, Scene};
+use crate::options::{Filter, RenderOptions};
+use crate::progress::Progress;
+use crate::stats::counter::{NoCount, RayCounter, RayCounts};
 
 /// Rows per parallel work item: small enough to balance two cores on a 100-row image, large
 /// enough that scheduling costs nothing.
@@ -19,19 +19,6 @@ const BAND_ROWS: usize = 4;
 /// The [1 2 1]⊗[1 2 1]/16 kernel over each output pixel's 3×3 block of supersamples.
 const GAUSSIAN_WEIGHTS: [Real; 3] = [0.25, 0.5, 0.25];
 
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RenderOptions {
-    pub width: u32,
-    pub height: u32,
-    pub bounces: u32,
-    pub shadows: bool,
-    pub samples: u32,
-    pub seed: u64,
-    pub filter: Filter,
-    /// Whether anything reads the depth and normal AOVs. Without them no ray is traced for
-    /// them and the film's `depth` and `normal` stay as [`Film::new`] made them: all misses.
-    pub aovs: bool,
-}
 
 /// Renders the scene without counting anything.
 pub fn render(scene: &Scene, options: &RenderOptions, progress: &Progress) -> Film {
@@ -54,7 +41,7 @@ fn render_counted<C: RayCounter>(scene: &Scene, options: &RenderOptions, progres
     let mut film = Film::new(options.width, options.height);
     let pixels = PixelRenderer {
         scene,
-        integrator: Whitted::new(scene, options.bounces, options.shadows),
+        integrator: Whitted::new(scene, options.bounces, options.shadows, options.spawn),
         sampler: Sampler::new(options.samples, options.seed),
         options,
     };

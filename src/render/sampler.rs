@@ -2,7 +2,7 @@
 //! (seed, pixel, sample index): tiles can render in any order on any number of threads and the
 //! picture is bit-identical.
 
-use crate::real::{Real, Vec2};
+use super::real::{Real, Vec2};
 
 #[derive(Clone, Copy, Debug)]
 pub struct Sampler {

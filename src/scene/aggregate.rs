@@ -1,10 +1,10 @@
 //! All of a scene's geometry: bounded objects under a BVH, infinite planes beside it.
 
 use super::object::{Object, ShapeHit};
-use crate::geometry::bvh::Bvh;
-use crate::geometry::plane::Plane;
-use crate::geometry::{Ray, SurfaceHit};
-use crate::real::Real;
+use super::geometry::bvh::Bvh;
+use super::geometry::plane::Plane;
+use super::geometry::{Ray, SurfaceHit};
+use super::real::Real;
 
 /// Below this many objects a linear scan is cheaper than a BVH, and a scene of one sphere pays
 /// for no tree at all.

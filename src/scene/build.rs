@@ -8,28 +8,19 @@ use std::time::Instant;
 
 use glam::{DMat4, DVec3};
 
-use super::{Aggregate, Background, CubeMap, CubeMapError, Object, Scene, Shape, Triangle};
-use crate::case::{Case, LightSpec, ObjectSpec, ShapeSpec, SourceLocation, composite_matrix};
-use crate::geometry::mesh::{Mesh, MeshError, NormalSource};
-use crate::geometry::plane::Plane;
-use crate::geometry::sphere::Sphere;
-use crate::geometry::transform::{Transform, TransformError};
-use crate::real::{mat4, real, vec3};
-use crate::render::Profile;
-use crate::render::camera::Camera;
-use crate::render::light::Light;
-use crate::render::material::Material;
-use crate::stats::{BuildStats, BvhStats, MeshStats};
-
-#[derive(Debug, thiserror::Error)]
-pub enum BuildError {
-    #[error("{location}: cannot load mesh: {source}")]
-    Mesh { location: SourceLocation, source: MeshError },
-    #[error("{location}: {source}")]
-    Transform { location: SourceLocation, source: TransformError },
-    #[error("{file}: {source}")]
-    CubeMap { file: PathBuf, source: CubeMapError },
-}
+use super::geometry::mesh::{Mesh, NormalSource};
+use super::geometry::plane::Plane;
+use super::geometry::sphere::Sphere;
+use super::geometry::transform::Transform;
+use super::real::{Vec3, mat4, real, vec3};
+use super::render::camera::Camera;
+use super::render::light::Light;
+use super::render::material::Material;
+use super::{Aggregate, Background, CubeMap, Object, Scene, Shape, Triangle};
+use crate::build_error::{BuildError, MeshError, TransformError};
+use crate::case::{Case, LightSpec, ObjectSpec, ShapeSpec, composite_matrix};
+use crate::options::Profile;
+use crate::stats::{BuildStats, MeshStats};
 
 pub fn build_scene(case: &Case) -> Result<Scene, BuildError> {
     build_scene_measured(case).map(|(scene, _)| scene)
@@ -37,11 +28,18 @@ pub fn build_scene(case: &Case) -> Result<Scene, BuildError> {
 
 /// [`build_scene`], also reporting each mesh's load and BVH build and the scene's BVH, for
 /// `--stats`.
+///
+/// The scene is built in camera-world space (pbrt-v4's default): everything is moved, in `f64`,
+/// so that the camera sits at the origin before any coordinate is rounded to `Real`. Where
+/// rays start is then where precision is finest, and a scene moved far from the origin renders
+/// the same picture instead of losing digits to the distance.
 pub fn build_scene_measured(case: &Case) -> Result<(Scene, BuildStats), BuildError> {
     let camera_spec = &case.camera;
+    let eye = DVec3::from(camera_spec.center);
+    let to_camera_world = (eye != DVec3::ZERO).then(|| DMat4::from_translation(-eye));
     let camera = Camera::new(
         case.render.profile,
-        vec3(camera_spec.center),
+        Vec3::ZERO,
         vec3(camera_spec.direction),
         vec3(camera_spec.up),
         real(camera_spec.fov),
@@ -73,30 +71,32 @@ pub fn build_scene_measured(case: &Case) -> Result<(Scene, BuildStats), BuildErr
         uses_default_material: false,
     };
     for spec in &case.objects {
-        builder.add(spec, None, None)?;
+        builder.add(spec, to_camera_world, None)?;
     }
     if builder.uses_default_material {
         materials.push(Material::default());
     }
     let bvh_start = Instant::now();
     let geometry = Aggregate::new(builder.objects, builder.planes);
-    let scene_bvh = geometry.bvh().map(|bvh| BvhStats::of(bvh, bvh_start.elapsed()));
+    let scene_bvh = geometry.bvh().map(|bvh| bvh.stats(bvh_start.elapsed()));
     let scene = Scene {
         camera,
         background,
         ambient: vec3(case.background.ambient),
-        lights: case.lights.iter().map(light).collect(),
+        lights: case.lights.iter().map(|spec| light(spec, eye)).collect(),
         materials,
         geometry,
     };
     Ok((scene, BuildStats { cube_map_load_time, meshes: builder.mesh_stats, scene_bvh }))
 }
 
-fn light(spec: &LightSpec) -> Light {
+fn light(spec: &LightSpec, eye: DVec3) -> Light {
     match *spec {
-        LightSpec::Point { position, color, falloff } => {
-            Light::Point { position: vec3(position), color: vec3(color), falloff: real(falloff) }
-        }
+        LightSpec::Point { position, color, falloff } => Light::Point {
+            position: vec3((DVec3::from(position) - eye).to_array()),
+            color: vec3(color),
+            falloff: real(falloff),
+        },
         LightSpec::Directional { direction, color } => {
             Light::Directional { direction: vec3(direction).normalize(), color: vec3(color) }
         }
@@ -144,7 +144,11 @@ impl Builder {
                 self.objects.push(Object { shape: Shape::Triangle(triangle), transform: None, material });
             }
             ShapeSpec::Sphere { center, radius } => {
-                let shape = Shape::Sphere(Sphere { center: vec3(*center), radius: real(*radius) });
+                let (center, matrix) = match matrix {
+                    Some(m) if is_translation(m) => (m.transform_point3(DVec3::from(*center)), None),
+                    _ => (DVec3::from(*center), matrix),
+                };
+                let shape = Shape::Sphere(Sphere { center: vec3(center.to_array()), radius: real(*radius) });
                 self.push_instanced(shape, matrix, material).map_err(transform_error)?;
             }
             ShapeSpec::Mesh { obj } => {
@@ -173,11 +177,17 @@ impl Builder {
             path: path.to_path_buf(),
             triangles: mesh.triangle_count(),
             load_time: start.elapsed().saturating_sub(bvh_build_time),
-            bvh: BvhStats::of(mesh.bvh(), bvh_build_time),
+            bvh: mesh.bvh().stats(bvh_build_time),
         });
         self.meshes.insert(path.to_path_buf(), mesh.clone());
         Ok(mesh)
     }
+}
+
+/// A translated sphere is a sphere with another centre: moving it costs nothing per ray, where
+/// instancing would transform every ray that meets its box.
+fn is_translation(matrix: DMat4) -> bool {
+    glam::DMat3::from_mat4(matrix) == glam::DMat3::IDENTITY && matrix.row(3) == glam::DVec4::W
 }
 
 /// Planes stay analytic under any affine transform: the normal goes by the inverse transpose
@@ -215,7 +225,6 @@ fn inverse_linear(matrix: DMat4) -> Result<glam::DMat3, TransformError> {
 mod tests {
     use super::*;
 
-    use crate::real::Vec3;
 
     #[test]
     fn transformed_plane_moves_with_its_matrix() {

@@ -2,18 +2,12 @@
 //! (DESIGN.md, "The assignment profile"): texel row 0 is the PNG's top row, faces chosen by the
 //! largest component, bilinear weights with edge-clamped indices.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use rayon::prelude::*;
 
-use crate::real::{Color, Real, Vec3};
-
-#[derive(Debug, thiserror::Error)]
-#[error("cannot load cube map face {path}: {reason}")]
-pub struct CubeMapError {
-    pub path: PathBuf,
-    pub reason: String,
-}
+use super::real::{Color, Real, Vec3};
+pub use crate::build_error::CubeMapError;
 
 /// One face: linear texel values `byte / 255` (the reference applies no gamma), row 0 at the top.
 #[derive(Debug)]

@@ -6,14 +6,15 @@ mod cube_map;
 mod object;
 
 pub use aggregate::{Aggregate, Intersection};
-pub use build::{BuildError, build_scene, build_scene_measured};
-pub use cube_map::{CubeMap, CubeMapError};
+pub use build::{build_scene, build_scene_measured};
+pub use cube_map::CubeMap;
 pub use object::{Object, Shape, ShapeHit, Triangle};
 
-use crate::render::camera::Camera;
-use crate::render::light::Light;
-use crate::render::material::Material;
-use crate::real::{Color, Vec3};
+use super::{geometry, real, render};
+use render::camera::Camera;
+use render::light::Light;
+use render::material::Material;
+use real::{Color, Vec3};
 
 /// What a ray that hits nothing sees.
 #[derive(Debug)]

@@ -2,13 +2,13 @@
 
 use std::sync::Arc;
 
-use crate::geometry::aabb::Aabb;
-use crate::geometry::mesh::{Mesh, MeshHit};
-use crate::geometry::sphere::Sphere;
-use crate::geometry::transform::Transform;
-use crate::geometry::triangle::{TriangleHit, TriangleRay, intersect_triangle, triangle_surface};
-use crate::geometry::{Ray, SurfaceHit};
-use crate::real::{Real, Vec3};
+use super::geometry::aabb::Aabb;
+use super::geometry::mesh::{Mesh, MeshHit};
+use super::geometry::sphere::Sphere;
+use super::geometry::transform::Transform;
+use super::geometry::triangle::{TriangleHit, TriangleRay, intersect_triangle, triangle_surface};
+use super::geometry::{Ray, SurfaceHit};
+use super::real::{Real, Vec3};
 
 #[derive(Clone, Debug)]
 pub struct Triangle {

@@ -3,9 +3,12 @@
 //! after the render (like pbrt), `--stats-json FILE` saves the same numbers for scripts.
 //!
 //! Gathering them costs a handful of clock readings and one counter per band of rows (see
-//! [`crate::render::counter`]); none of it touches the image.
+//! [`counter`]); none of it touches the image.
 
+pub mod counter;
 mod table;
+
+pub use counter::RayCounts;
 
 use std::path::{Path, PathBuf};
 use std::time::Duration;
@@ -14,8 +17,6 @@ use serde::{Serialize, Serializer};
 
 use crate::case::Case;
 use crate::film::{OutputError, write_file_atomic};
-use crate::geometry::bvh::Bvh;
-use crate::render::RayCounts;
 
 /// Why `--stats-json` could not be written.
 #[derive(Debug, thiserror::Error)]
@@ -35,17 +36,6 @@ pub struct BvhStats {
     pub primitives: usize,
     pub nodes: usize,
     pub leaves: usize,
-}
-
-impl BvhStats {
-    pub fn of(bvh: &Bvh, build_time: Duration) -> BvhStats {
-        BvhStats {
-            build_time,
-            primitives: bvh.prim_indices().len(),
-            nodes: bvh.node_count(),
-            leaves: bvh.leaf_count(),
-        }
-    }
 }
 
 /// One mesh file, loaded once however many objects use it.

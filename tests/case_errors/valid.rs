@@ -5,7 +5,7 @@ use goldray::case::{
     TransformOp, load,
 };
 use goldray::film::Tonemap;
-use goldray::render::{Filter, Profile};
+use goldray::options::{Filter, Profile};
 
 use super::*;
 

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use goldray::case::{LoadOptions, load};
-use goldray::render::Filter;
+use goldray::options::Filter;
 use serde_json::Value;
 
 fn goldray(args: &[&str]) -> Output {

@@ -1,9 +1,12 @@
 //! "Do only what a scene requires", checked by counting: each test fails if the renderer traces a
 //! ray, or builds a tree, that nothing in the scene or its outputs asks for.
 
+use goldray::options::RenderOptions;
 use goldray::pipeline::render_options;
-use goldray::render::{Progress, RenderOptions, render_counting_rays};
+use goldray::progress::Progress;
+use goldray::render::render_counting_rays;
 use goldray::scene::build_scene;
+use goldray::stats::RayCounts;
 
 use super::{SPHERE, TWO_POINT_LIGHTS, case, counted, hits};
 
@@ -48,7 +51,7 @@ fn no_aov_rays_when_no_aov_is_written() {
         let (film, counts) = render_counting_rays(&scene, &with, &Progress::hidden());
         let (bare, bare_counts) = render_counting_rays(&scene, &without, &Progress::hidden());
         assert_eq!(bare_counts.aov, 0, "{render:?}");
-        assert_eq!(bare_counts, goldray::render::RayCounts { aov: 0, ..counts }, "{render:?}");
+        assert_eq!(bare_counts, RayCounts { aov: 0, ..counts }, "{render:?}");
         assert!(bare.color == film.color, "{render:?}: the AOVs changed the colour");
         assert!(hits(&film) > 0 && hits(&bare) == 0, "{render:?}: AOVs were written");
         assert!(bare.normal.iter().all(|n| *n == [0.0; 3]), "{render:?}");

@@ -5,8 +5,8 @@
 //! parallel are stitched together in a fixed order, so the result does not depend on how rayon
 //! schedules the work.
 
-use crate::geometry::aabb::Aabb;
-use crate::real::{Real, Vec3};
+use super::super::aabb::Aabb;
+use super::super::real::{Real, Vec3};
 
 /// Twelve bins find splits within a few percent of a full sweep at a fraction of its cost.
 const BIN_COUNT: usize = 12;

@@ -9,7 +9,7 @@
 
 use super::build::BinaryNode;
 use super::{BvhNode, WIDTH};
-use crate::real::Real;
+use super::super::real::Real;
 
 /// The wide nodes in depth-first order (a node's first interior child follows it), root first.
 pub(super) fn collapse(binary: &[BinaryNode]) -> Vec<BvhNode> {
