@@ -16,6 +16,12 @@ pub struct AssignmentOutputs {
 }
 
 impl AssignmentOutputs {
+    /// Whether any file written needs the depth and normal AOVs: the normals and depth PNGs and
+    /// the EXR do, the colour PNG does not.
+    pub fn writes_aovs(&self) -> bool {
+        self.normals.is_some() || self.depth.is_some() || self.exr.is_some()
+    }
+
     /// Encodes every file before writing any, so a film that cannot be encoded writes nothing;
     /// each file is then replaced atomically.
     pub fn write(&self, film: &Film) -> Result<Vec<PathBuf>, OutputError> {

@@ -70,4 +70,8 @@ pub struct RenderOptions {
     pub seed: u64,
     pub filter: Filter,
     pub spawn: Spawn,
+    /// Whether anything reads the depth and normal AOVs. Without them no ray is traced for
+    /// them and the film's `depth` and `normal` stay as [`crate::film::Film::new`] made them:
+    /// all misses.
+    pub aovs: bool,
 }

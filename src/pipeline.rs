@@ -27,16 +27,17 @@ pub fn render_case(case: &Case, show_progress: bool) -> Result<Film, Error> {
     })
 }
 
-/// [`render_case`], also counting rays and measuring the scene build (for `--stats`). The
-/// scene is freed before this returns, so measuring adds no memory to what follows.
-pub fn render_case_measured(case: &Case, show_progress: bool) -> Result<MeasuredRender, Error> {
+/// [`render_case`], also counting rays and measuring the scene build (for `--stats`), with the
+/// depth and normal AOVs only when `aovs`. The scene is freed before this returns, so measuring
+/// adds no memory to what follows.
+pub fn render_case_measured(case: &Case, show_progress: bool, aovs: bool) -> Result<MeasuredRender, Error> {
     with_precision!(case.render.precision, p => {
         let start = Instant::now();
         let (scene, build_stats) = p::scene::build_scene_measured(case)?;
         let build_time = start.elapsed();
         let render_start = Instant::now();
-        let (film, rays) =
-            p::render::render_counting_rays(&scene, &render_options(case), &progress(case, show_progress));
+        let options = RenderOptions { aovs, ..render_options(case) };
+        let (film, rays) = p::render::render_counting_rays(&scene, &options, &progress(case, show_progress));
         Ok(MeasuredRender { film, rays, build_stats, build_time, render_time: render_start.elapsed() })
     })
 }
@@ -51,7 +52,8 @@ pub struct MeasuredRender {
     pub render_time: Duration,
 }
 
-/// The renderer's options from a case's `[render]` table.
+/// The renderer's options from a case's `[render]` table. A case's render always writes the
+/// EXR, whose `Z` and `N` channels are the AOVs, so they are always traced.
 pub fn render_options(case: &Case) -> RenderOptions {
     let settings = &case.render;
     RenderOptions {
@@ -63,6 +65,7 @@ pub fn render_options(case: &Case) -> RenderOptions {
         seed: settings.seed,
         filter: settings.filter,
         spawn: Spawn::ErrorBounds,
+        aovs: true,
     }
 }
 
@@ -90,33 +93,41 @@ pub fn render_case_file(
     measured_run(
         || Ok(case::load(path, load)?),
         show_progress,
+        true,
         |case, film| Ok(write_outputs(out_dir, &case.name, film, &output_options(case))?),
     )
 }
 
 /// `goldray mit6837`: renders a course scene file as the course binary would and writes the
-/// files its flags name.
+/// files its flags name; the depth and normal AOVs are traced only when one of them is written.
 pub fn render_assignment(
     scene: &Path,
     options: &AssignmentOptions,
     outputs: &AssignmentOutputs,
     show_progress: bool,
 ) -> Result<Rendered, Error> {
-    measured_run(|| Ok(load_assignment_scene(scene, options)?), show_progress, |_, film| Ok(outputs.write(film)?))
+    measured_run(
+        || Ok(load_assignment_scene(scene, options)?),
+        show_progress,
+        outputs.writes_aovs(),
+        |_, film| Ok(outputs.write(film)?),
+    )
 }
 
-/// Load, build, render and write, timing each phase and counting rays. The commands always
-/// measure: counting costs nothing measurable (`cargo bench -- stats_overhead`), so `--stats`
-/// only decides whether the numbers are shown, and can never change what is rendered.
+/// Load, build, render (with the AOVs when `aovs`) and write, timing each phase and counting
+/// rays. The commands always measure: counting costs nothing measurable (`cargo bench --
+/// stats_overhead`), so `--stats` only decides whether the numbers are shown, and can never
+/// change what is rendered.
 fn measured_run(
     load: impl FnOnce() -> Result<Case, Error>,
     show_progress: bool,
+    aovs: bool,
     write: impl FnOnce(&Case, &Film) -> Result<Vec<PathBuf>, Error>,
 ) -> Result<Rendered, Error> {
     let start = Instant::now();
     let case = load()?;
     let parse = start.elapsed();
-    let measured = render_case_measured(&case, show_progress)?;
+    let measured = render_case_measured(&case, show_progress, aovs)?;
     let write_start = Instant::now();
     let written = write(&case, &measured.film)?;
     let phases = Phases {

@@ -3,6 +3,8 @@
 
 #[path = "render_stats/cli.rs"]
 mod cli;
+#[path = "render_stats/required.rs"]
+mod required;
 
 use std::path::Path;
 

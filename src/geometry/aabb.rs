@@ -84,38 +84,56 @@ impl Aabb {
         }
     }
 
-    /// Whether the ray meets the box for some `t` in `[0, t_max]`.
-    ///
-    /// Conservative: it may report a hit the exact test would not, but never misses a box the
-    /// ray really touches, which is what keeps BVH traversal from losing triangles. Two details
-    /// make that so. The far distance on each axis is scaled by `1 + 2·gamma(3)` (pbrt-v4), which
-    /// covers the rounding of the subtraction and multiplication. And a zero direction component
-    /// gives an infinite inverse, so an origin lying exactly on that slab's plane computes
-    /// `0 · ∞ = NaN`; the comparisons below are false for NaN, so that slab then constrains
-    /// nothing, i.e. the plane counts as inside the box, as a closed box should.
+    /// Whether the ray meets the box for some `t` in `[0, t_max]`: [`hit_lanes`] for one box.
     #[inline]
     pub fn hit_by(&self, ray: &SlabRay, t_max: Real) -> bool {
-        let far_scale = 1.0 + 2.0 * gamma(3);
-        let mut t_enter: Real = 0.0;
-        let mut t_exit = t_max;
-        for axis in 0..3 {
-            let (near, far) = if ray.direction_is_negative[axis] {
-                (self.max[axis], self.min[axis])
-            } else {
-                (self.min[axis], self.max[axis])
-            };
-            let t_near = (near - ray.origin[axis]) * ray.inverse_direction[axis];
-            let t_far = (far - ray.origin[axis]) * ray.inverse_direction[axis] * far_scale;
+        let lanes = |v: Vec3| [[v.x], [v.y], [v.z]];
+        hit_lanes(&lanes(self.min), &lanes(self.max), ray, t_max).1[0]
+    }
+}
+
+/// The slab test of `N` boxes at once, each box one lane of the per-axis arrays `min` and `max`
+/// (structure of arrays, so that the compiler runs the lanes side by side in SIMD registers).
+/// Returns each box's entry distance and whether the ray meets it for some `t` in `[0, t_max]`.
+///
+/// Conservative: it may report a hit the exact test would not, but never misses a box the
+/// ray really touches, which is what keeps BVH traversal from losing triangles. Two details
+/// make that so. The far distance on each axis is scaled by `1 + 2·gamma(3)` (pbrt-v4), which
+/// covers the rounding of the subtraction and multiplication. And a zero direction component
+/// gives an infinite inverse, so an origin lying exactly on that slab's plane computes
+/// `0 · ∞ = NaN`; the comparisons below are false for NaN, so that slab then constrains
+/// nothing, i.e. the plane counts as inside the box, as a closed box should. An empty box
+/// (`min = +∞`, `max = −∞`) is never hit: its far distance is `−∞` on every axis.
+#[inline(always)]
+pub fn hit_lanes<const N: usize>(
+    min: &[[Real; N]; 3],
+    max: &[[Real; N]; 3],
+    ray: &SlabRay,
+    t_max: Real,
+) -> ([Real; N], [bool; N]) {
+    let far_scale = 1.0 + 2.0 * gamma(3);
+    let mut t_enter: [Real; N] = [0.0; N];
+    let mut t_exit = [t_max; N];
+    for axis in 0..3 {
+        let (near, far) = if ray.direction_is_negative[axis] {
+            (&max[axis], &min[axis])
+        } else {
+            (&min[axis], &max[axis])
+        };
+        let (origin, inverse) = (ray.origin[axis], ray.inverse_direction[axis]);
+        for lane in 0..N {
+            let t_near = (near[lane] - origin) * inverse;
+            let t_far = (far[lane] - origin) * inverse * far_scale;
             // A NaN compares false and so leaves the running bound as it is.
-            if t_near > t_enter {
-                t_enter = t_near;
+            if t_near > t_enter[lane] {
+                t_enter[lane] = t_near;
             }
-            if t_far < t_exit {
-                t_exit = t_far;
+            if t_far < t_exit[lane] {
+                t_exit[lane] = t_far;
             }
         }
-        t_enter <= t_exit
     }
+    (t_enter, std::array::from_fn(|lane| t_enter[lane] <= t_exit[lane]))
 }
 
 /// The per-ray part of the slab test, computed once per ray instead of once per box.

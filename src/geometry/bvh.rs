@@ -5,56 +5,75 @@
 //! one implementation for triangle meshes and for scene-level object lists.
 
 mod build;
+mod collapse;
 
 use std::time::Duration;
 
+use smallvec::SmallVec;
+
 use super::Ray;
-use super::aabb::{Aabb, SlabRay};
+use super::aabb::{Aabb, SlabRay, hit_lanes};
 use super::real::Real;
 use crate::stats::BvhStats;
 
-/// Deepest tree [`Bvh::build`] can produce: SAH splits are allowed up to `build::SAH_DEPTH_LIMIT`
-/// levels, after which median splits at most halve `u32::MAX` primitives down to a leaf. Sizing
-/// the traversal stack from it means the stack can never overflow.
-const MAX_DEPTH: usize = build::SAH_DEPTH_LIMIT + 33;
+/// Children per node: four boxes are tested at once, one per SIMD lane.
+const WIDTH: usize = 4;
 
-/// One node of the flattened tree, 32 bytes with `f32` bounds so that two fit a cache line.
+/// Deepest binary tree [`Bvh::build`] can produce: SAH splits are allowed up to
+/// `build::SAH_DEPTH_LIMIT` levels, after which median splits at most halve `u32::MAX` primitives
+/// down to a leaf. The wide tree is no deeper, and each node visited pushes at most `WIDTH − 1`
+/// children (the nearest is visited next), which sizes the traversal stack so that it can never
+/// overflow.
+const STACK_SIZE: usize = (WIDTH - 1) * (build::SAH_DEPTH_LIMIT + 33) + 1;
+
+/// One node of the 4-wide tree: the boxes of its (up to four) children side by side, one lane
+/// per child, so that one slab test covers all four. 128 bytes with `f32` bounds, aligned to
+/// two whole cache lines.
 ///
-/// Nodes are stored depth first: an interior node's first child immediately follows it, so only
-/// the second child's index needs storing.
+/// A child is either another node or a leaf, a run of primitives stored in the node itself.
+/// Unused slots have an empty box, which no ray enters.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(64))]
 pub struct BvhNode {
-    pub bounds: Aabb,
-    /// Leaf: index of its first entry in the primitive order. Interior: the second child.
-    offset: u32,
-    /// Zero for an interior node.
-    prim_count: u16,
-    /// The split axis of an interior node, used to visit the nearer child first.
-    axis: u16,
+    min: [[Real; WIDTH]; 3],
+    max: [[Real; WIDTH]; 3],
+    /// Interior child: its node's index. Leaf: the index of its first entry in the primitive order.
+    child: [u32; WIDTH],
+    /// Leaf: its number of primitives (at least one). Zero for an interior child or unused slot.
+    count: [u32; WIDTH],
 }
 
 impl BvhNode {
-    fn leaf(bounds: Aabb, first: u32, count: u16) -> Self {
-        BvhNode {
-            bounds,
-            offset: first,
-            prim_count: count,
-            axis: 0,
+    const EMPTY: BvhNode = BvhNode {
+        min: [[Real::INFINITY; WIDTH]; 3],
+        max: [[Real::NEG_INFINITY; WIDTH]; 3],
+        child: [0; WIDTH],
+        count: [0; WIDTH],
+    };
+
+    fn set_child(&mut self, lane: usize, bounds: &Aabb, child: u32, count: u32) {
+        for axis in 0..3 {
+            self.min[axis][lane] = bounds.min[axis];
+            self.max[axis][lane] = bounds.max[axis];
         }
+        self.child[lane] = child;
+        self.count[lane] = count;
     }
 
-    fn interior(bounds: Aabb, axis: usize, second_child: u32) -> Self {
-        BvhNode {
-            bounds,
-            offset: second_child,
-            prim_count: 0,
-            axis: axis as u16,
-        }
+    /// Number of leaves among the children.
+    fn leaf_count(&self) -> usize {
+        self.count.iter().filter(|&&count| count > 0).count()
     }
+}
 
-    pub fn is_leaf(&self) -> bool {
-        self.prim_count > 0
-    }
+/// A child waiting on the traversal stack: `count == 0` for a node, else a leaf's run of
+/// primitives; `t` is where the ray enters its box, so that it is skipped once a hit nearer
+/// than that is known.
+#[derive(Clone, Copy)]
+struct Pending {
+    t: Real,
+    index: u32,
+    count: u32,
 }
 
 /// What a traversal visitor asks the traversal to do next.
@@ -67,10 +86,13 @@ enum Visit {
 pub struct Bvh {
     nodes: Vec<BvhNode>,
     prim_indices: Vec<u32>,
+    /// Box around every primitive (the root node holds only its children's boxes).
+    bounds: Aabb,
 }
 
 impl Bvh {
-    /// Builds the tree with a binned surface-area heuristic.
+    /// Builds a binary tree with a binned surface-area heuristic and collapses it into a 4-wide
+    /// one (nodes of up to four children).
     ///
     /// Deterministic: the tree depends only on `bounds`, never on the number of rayon threads
     /// that build its subtrees. Boxes may be empty or degenerate (points, identical copies);
@@ -79,9 +101,10 @@ impl Bvh {
     /// # Panics
     /// If there are more than `u32::MAX` primitives.
     pub fn build(bounds: &[Aabb]) -> Bvh {
-        let (nodes, prim_indices) = build::build(bounds);
+        let (binary, prim_indices) = build::build(bounds);
         Bvh {
-            nodes,
+            bounds: binary.first().map_or(Aabb::EMPTY, |root| root.bounds),
+            nodes: collapse::collapse(&binary),
             prim_indices,
         }
     }
@@ -97,6 +120,7 @@ impl Bvh {
             Bvh {
                 nodes: self.nodes,
                 prim_indices: identity,
+                bounds: self.bounds,
             },
             self.prim_indices,
         )
@@ -107,26 +131,24 @@ impl Bvh {
         &self.prim_indices
     }
 
-    pub fn nodes(&self) -> &[BvhNode] {
-        &self.nodes
-    }
-
     /// Its shape for `--stats`.
     pub fn stats(&self, build_time: Duration) -> BvhStats {
         BvhStats { build_time, primitives: self.prim_indices().len(), nodes: self.node_count(), leaves: self.leaf_count() }
     }
 
+    /// Number of (4-wide) nodes.
     pub fn node_count(&self) -> usize {
         self.nodes.len()
     }
 
+    /// Number of leaves, each a run of at most four primitives.
     pub fn leaf_count(&self) -> usize {
-        self.nodes.iter().filter(|node| node.is_leaf()).count()
+        self.nodes.iter().map(BvhNode::leaf_count).sum()
     }
 
     /// Box around every primitive; empty when there are none.
     pub fn bounds(&self) -> Aabb {
-        self.nodes.first().map_or(Aabb::EMPTY, |root| root.bounds)
+        self.bounds
     }
 
     /// Finds the nearest primitive along the ray in `(0, t_max]`.
@@ -169,46 +191,62 @@ impl Bvh {
         found
     }
 
-    /// Depth-first traversal with an explicit stack, nearer child first: with the ray heading
-    /// towards −axis the second child (the upper half of the split) is the nearer one. The
-    /// visitor may shrink `t_limit`, which prunes every box entered afterwards.
+    /// Depth-first traversal with an explicit stack, nearest child first: each node's four boxes
+    /// are tested at once, the children hit are ordered by where the ray enters them, the
+    /// nearest is visited next and the others wait on the stack with their entry distance. The
+    /// visitor may shrink `t_limit`, which prunes every box entered beyond it.
     fn traverse(&self, ray: &Ray, t_max: Real, mut visit: impl FnMut(u32, &mut Real) -> Visit) {
         if self.nodes.is_empty() || !(ray.origin.is_finite() && ray.direction.is_finite()) {
             return;
         }
         let slab_ray = SlabRay::new(ray);
         let mut t_limit = t_max;
-        let mut stack = [0u32; MAX_DEPTH];
-        let mut stack_len = 0;
-        let mut node_index = 0usize;
+        // Inline storage that is never spilled (see `STACK_SIZE`) and, unlike an array, not
+        // initialised: zeroing the whole bound for every ray would cost more than most rays push.
+        let mut stack: SmallVec<[Pending; STACK_SIZE]> = SmallVec::new();
+        let mut current = Pending { t: 0.0, index: 0, count: 0 };
         loop {
-            let node = &self.nodes[node_index];
-            if node.bounds.hit_by(&slab_ray, t_limit) {
-                if node.is_leaf() {
-                    let first = node.offset as usize;
-                    for &prim in &self.prim_indices[first..first + node.prim_count as usize] {
-                        if let Visit::Stop = visit(prim, &mut t_limit) {
-                            return;
+            if current.count == 0 {
+                let node = &self.nodes[current.index as usize];
+                let (t_enter, hit) = hit_lanes(&node.min, &node.max, &slab_ray, t_limit);
+                // Insertion sort of the (at most four) children hit, nearest first.
+                let mut near = [current; WIDTH];
+                let mut near_len = 0;
+                for lane in 0..WIDTH {
+                    if hit[lane] {
+                        let child = Pending { t: t_enter[lane], index: node.child[lane], count: node.count[lane] };
+                        let mut k = near_len;
+                        while k > 0 && near[k - 1].t > child.t {
+                            near[k] = near[k - 1];
+                            k -= 1;
                         }
+                        near[k] = child;
+                        near_len += 1;
                     }
-                } else {
-                    let first_child = node_index as u32 + 1;
-                    let (near, far) = if slab_ray.direction_is_negative[node.axis as usize] {
-                        (node.offset, first_child)
-                    } else {
-                        (first_child, node.offset)
-                    };
-                    stack[stack_len] = far;
-                    stack_len += 1;
-                    node_index = near as usize;
+                }
+                if near_len > 0 {
+                    for &farther in near[1..near_len].iter().rev() {
+                        stack.push(farther);
+                    }
+                    current = near[0];
                     continue;
                 }
+            } else {
+                let first = current.index as usize;
+                for &prim in &self.prim_indices[first..first + current.count as usize] {
+                    if let Visit::Stop = visit(prim, &mut t_limit) {
+                        return;
+                    }
+                }
             }
-            if stack_len == 0 {
-                return;
+            loop {
+                let Some(pending) = stack.pop() else { return };
+                // The box was hit before `t_limit` shrank; entered beyond it, it holds nothing nearer.
+                if pending.t <= t_limit {
+                    current = pending;
+                    break;
+                }
             }
-            stack_len -= 1;
-            node_index = stack[stack_len] as usize;
         }
     }
 }
@@ -236,10 +274,28 @@ mod tests {
     }
 
     #[test]
-    fn node_is_32_bytes_with_f32() {
+    fn node_is_two_cache_lines_with_f32() {
         if size_of::<Real>() == 4 {
-            assert_eq!(size_of::<BvhNode>(), 32);
+            assert_eq!((size_of::<BvhNode>(), align_of::<BvhNode>()), (128, 64));
         }
+    }
+
+    #[test]
+    fn wide_nodes_have_two_to_four_children_and_keep_every_leaf() {
+        let points: Vec<Vec3> = (0..2000)
+            .map(|i| Vec3::new((i * 37 % 101) as Real, (i * 11 % 13) as Real, (i % 7) as Real))
+            .collect();
+        let boxes = point_boxes(&points);
+        let (binary, _) = build::build(&boxes);
+        let bvh = Bvh::build(&boxes);
+        let binary_leaves = binary.iter().filter(|node| node.is_leaf()).count();
+        assert_eq!(bvh.leaf_count(), binary_leaves);
+        for node in &bvh.nodes {
+            let used = (0..WIDTH).filter(|&lane| node.min[0][lane] <= node.max[0][lane]).count();
+            assert!((2..=WIDTH).contains(&used), "{used} children");
+            assert!(node.count.iter().all(|&count| count <= 4));
+        }
+        assert!(bvh.node_count() * 2 < binary.len(), "{} wide nodes for {} binary ones", bvh.node_count(), binary.len());
     }
 
     #[test]
@@ -270,11 +326,11 @@ mod tests {
     #[test]
     fn coincident_centroids_split_into_small_leaves() {
         let bvh = Bvh::build(&point_boxes(&vec![Vec3::ONE; 1000]));
-        let leaf_sizes: Vec<u16> = bvh
-            .nodes()
+        let leaf_sizes: Vec<u32> = bvh
+            .nodes
             .iter()
-            .filter(|n| n.is_leaf())
-            .map(|n| n.prim_count)
+            .flat_map(|n| n.count)
+            .filter(|&count| count > 0)
             .collect();
         assert!(leaf_sizes.iter().all(|&count| count <= 4), "{leaf_sizes:?}");
         assert_eq!(leaf_sizes.iter().map(|&c| c as usize).sum::<usize>(), 1000);

@@ -94,7 +94,7 @@ impl PixelRenderer<'_> {
             Filter::None if self.sampler.samples_per_pixel() == 1 => {
                 rays.camera += 1;
                 let (color, first) = self.integrator.trace(self.scene.camera.ray(centre, width, height), rays);
-                Pixel::new(color, first.as_ref())
+                Pixel::new(color, first.filter(|_| self.options.aovs).as_ref())
             }
             Filter::None => {
                 let color = self.samples(x, y, width, height, rays);
@@ -126,8 +126,11 @@ impl PixelRenderer<'_> {
     }
 
     /// The AOVs come from one ray through the output pixel's centre: depth and normals averaged
-    /// across an edge would describe no surface at all.
+    /// across an edge would describe no surface at all. Traced only when the AOVs are wanted.
     fn first_hit(&self, centre: Vec2, rays: &mut RayCounts) -> Option<Intersection> {
+        if !self.options.aovs {
+            return None;
+        }
         rays.aov += 1;
         let ray = self.scene.camera.ray(centre, self.options.width, self.options.height);
         self.scene.geometry.intersect(&ray)

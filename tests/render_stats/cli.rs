@@ -122,7 +122,9 @@ fn every_shipped_case_reports_statistics() {
         for mesh in json["meshes"].as_array().unwrap() {
             let bvh = &mesh["bvh"];
             assert_eq!(bvh["primitives"], mesh["triangles"], "{}", case.name);
-            assert!(bvh["leaves"].as_u64().unwrap() > 0 && bvh["nodes"].as_u64() >= bvh["leaves"].as_u64());
+            // A 4-wide tree: each node holds two to four children (a lone leaf is one node's only child).
+            let (nodes, leaves) = (bvh["nodes"].as_u64().unwrap(), bvh["leaves"].as_u64().unwrap());
+            assert!(nodes > 0 && nodes <= leaves && 3 * nodes + 1 >= leaves, "{}: {nodes} nodes, {leaves} leaves", case.name);
         }
     }
 }
@@ -144,16 +146,25 @@ fn the_course_command_takes_the_stats_flags_too() {
     .unwrap();
     let json_path = dir.path().join("stats.json");
     let png = dir.path().join("out.png");
-    let result = goldray(&[
-        "mit6837", "-input", scene.to_str().unwrap(), "-output", png.to_str().unwrap(), "-size", "10", "10", "-shadows", "-jitter",
-        "-stats", "-stats-json", json_path.to_str().unwrap(), "--quiet",
-    ]);
-    assert!(result.status.success(), "{}", stderr(&result));
-    assert!(stderr(&result).contains("Statistics for two_lights (10×10"), "{}", stderr(&result));
-    let json = read_json(&json_path);
-    assert_eq!((count(&json, "camera"), count(&json, "aov")), (1600, 100), "16 jittered samples per pixel");
+    let normals = dir.path().join("normals.png");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "mit6837", "-input", scene.to_str().unwrap(), "-output", png.to_str().unwrap(), "-size", "10", "10", "-shadows",
+            "-jitter", "-stats", "-stats-json", json_path.to_str().unwrap(), "--quiet",
+        ];
+        args.extend_from_slice(extra);
+        let result = goldray(&args);
+        assert!(result.status.success(), "{}", stderr(&result));
+        assert!(stderr(&result).contains("Statistics for two_lights (10×10"), "{}", stderr(&result));
+        read_json(&json_path)
+    };
+    let json = run(&[]);
+    assert_eq!((count(&json, "camera"), count(&json, "aov")), (1600, 0), "16 jittered samples per pixel, no AOV written");
     let shadow = count(&json, "shadow");
     assert!(shadow > 0 && shadow.is_multiple_of(2), "two shadow rays per hit: {shadow}");
+    let json = run(&["-normals", normals.to_str().unwrap()]);
+    assert_eq!((count(&json, "camera"), count(&json, "aov")), (1600, 100), "the normals image needs the AOV rays");
+    assert_eq!(count(&json, "shadow"), shadow);
 }
 
 #[test]

@@ -1,10 +1,10 @@
-//! Binned-SAH construction of the flattened BVH.
+//! Binned-SAH construction of a flattened binary BVH, which `collapse` then turns into the 4-wide
+//! tree that is traversed.
 //!
 //! Every split decision is a pure function of the primitives in the node, and subtrees built in
 //! parallel are stitched together in a fixed order, so the result does not depend on how rayon
 //! schedules the work.
 
-use super::BvhNode;
 use super::super::aabb::Aabb;
 use super::super::real::{Real, Vec3};
 
@@ -23,8 +23,33 @@ const PARALLEL_THRESHOLD: usize = 4096;
 /// time on adversarial input; median splits guarantee the remaining depth is logarithmic.
 pub(super) const SAH_DEPTH_LIMIT: usize = 32;
 
+/// One node of the binary tree. Nodes are stored depth first: an interior node's first child
+/// immediately follows it, so only the second child's index needs storing.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct BinaryNode {
+    pub bounds: Aabb,
+    /// Leaf: index of its first entry in the primitive order. Interior: the second child.
+    pub offset: u32,
+    /// Zero for an interior node.
+    pub prim_count: u32,
+}
+
+impl BinaryNode {
+    fn leaf(bounds: Aabb, first: usize, count: usize) -> Self {
+        BinaryNode { bounds, offset: first as u32, prim_count: count as u32 }
+    }
+
+    fn interior(bounds: Aabb) -> Self {
+        BinaryNode { bounds, offset: 0, prim_count: 0 }
+    }
+
+    pub fn is_leaf(&self) -> bool {
+        self.prim_count > 0
+    }
+}
+
 /// Returns the nodes in depth-first order and the primitive indices in leaf order.
-pub(super) fn build(bounds: &[Aabb]) -> (Vec<BvhNode>, Vec<u32>) {
+pub(super) fn build(bounds: &[Aabb]) -> (Vec<BinaryNode>, Vec<u32>) {
     assert!(
         u32::try_from(bounds.len()).is_ok(),
         "a BVH holds at most u32::MAX primitives"
@@ -63,7 +88,6 @@ enum Plan {
     },
     Split {
         bounds: Aabb,
-        axis: usize,
         mid: usize,
     },
 }
@@ -71,10 +95,9 @@ enum Plan {
 /// A subtree as returned by a parallel task: either a finished run of nodes (child indices
 /// relative to the run's start) or a split whose children were built separately.
 enum Subtree {
-    Nodes(Vec<BvhNode>),
+    Nodes(Vec<BinaryNode>),
     Split {
         bounds: Aabb,
-        axis: usize,
         children: Box<(Subtree, Subtree)>,
     },
 }
@@ -86,8 +109,8 @@ fn build_parallel(prims: &mut [Prim], first: usize, depth: usize) -> Subtree {
         return Subtree::Nodes(nodes);
     }
     match plan(prims, depth) {
-        Plan::Leaf { bounds } => Subtree::Nodes(vec![leaf(bounds, first, prims.len())]),
-        Plan::Split { bounds, axis, mid } => {
+        Plan::Leaf { bounds } => Subtree::Nodes(vec![BinaryNode::leaf(bounds, first, prims.len())]),
+        Plan::Split { bounds, mid } => {
             let (below, above) = prims.split_at_mut(mid);
             let children = rayon::join(
                 || build_parallel(below, first, depth + 1),
@@ -95,19 +118,18 @@ fn build_parallel(prims: &mut [Prim], first: usize, depth: usize) -> Subtree {
             );
             Subtree::Split {
                 bounds,
-                axis,
                 children: Box::new(children),
             }
         }
     }
 }
 
-fn build_serial(prims: &mut [Prim], first: usize, depth: usize, nodes: &mut Vec<BvhNode>) {
+fn build_serial(prims: &mut [Prim], first: usize, depth: usize, nodes: &mut Vec<BinaryNode>) {
     match plan(prims, depth) {
-        Plan::Leaf { bounds } => nodes.push(leaf(bounds, first, prims.len())),
-        Plan::Split { bounds, axis, mid } => {
+        Plan::Leaf { bounds } => nodes.push(BinaryNode::leaf(bounds, first, prims.len())),
+        Plan::Split { bounds, mid } => {
             let index = nodes.len();
-            nodes.push(BvhNode::interior(bounds, axis, 0));
+            nodes.push(BinaryNode::interior(bounds));
             let (below, above) = prims.split_at_mut(mid);
             build_serial(below, first, depth + 1, nodes);
             nodes[index].offset = nodes.len() as u32;
@@ -116,13 +138,9 @@ fn build_serial(prims: &mut [Prim], first: usize, depth: usize, nodes: &mut Vec<
     }
 }
 
-fn leaf(bounds: Aabb, first: usize, count: usize) -> BvhNode {
-    BvhNode::leaf(bounds, first as u32, count as u16)
-}
-
 /// Appends the subtree in depth-first order, rebasing the relative child indices of each
 /// serially built run.
-fn flatten(subtree: Subtree, nodes: &mut Vec<BvhNode>) {
+fn flatten(subtree: Subtree, nodes: &mut Vec<BinaryNode>) {
     match subtree {
         Subtree::Nodes(run) => {
             let base = nodes.len() as u32;
@@ -133,13 +151,9 @@ fn flatten(subtree: Subtree, nodes: &mut Vec<BvhNode>) {
                 node
             }));
         }
-        Subtree::Split {
-            bounds,
-            axis,
-            children,
-        } => {
+        Subtree::Split { bounds, children } => {
             let index = nodes.len();
-            nodes.push(BvhNode::interior(bounds, axis, 0));
+            nodes.push(BinaryNode::interior(bounds));
             let (below, above) = *children;
             flatten(below, nodes);
             nodes[index].offset = nodes.len() as u32;
@@ -168,7 +182,6 @@ fn plan(prims: &mut [Prim], depth: usize) -> Plan {
         } else {
             Plan::Split {
                 bounds,
-                axis,
                 mid: count / 2,
             }
         };
@@ -201,7 +214,7 @@ fn plan(prims: &mut [Prim], depth: usize) -> Plan {
         return Plan::Leaf { bounds };
     }
     let mid = partition(prims, |prim| bin_of(prim) <= split_bin);
-    Plan::Split { bounds, axis, mid }
+    Plan::Split { bounds, mid }
 }
 
 /// The bin after which splitting is cheapest, with its cost `Σ count·area` over both sides.
@@ -246,7 +259,7 @@ fn median_split(prims: &mut [Prim], bounds: Aabb, axis: usize) -> Plan {
             .total_cmp(&b.centroid[axis])
             .then(a.index.cmp(&b.index))
     });
-    Plan::Split { bounds, axis, mid }
+    Plan::Split { bounds, mid }
 }
 
 /// Moves the primitives satisfying `goes_below` to the front and returns how many there are.

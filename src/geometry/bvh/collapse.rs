@@ -1,0 +1,63 @@
+//! Collapsing the binary SAH tree into the 4-wide tree that is traversed.
+//!
+//! A wide node takes the two children of a binary node and keeps replacing its interior child
+//! with the largest surface area (the one a ray is likeliest to enter) by that child's own two
+//! children, until it has four children or only leaves are left (the usual BVH2 → BVH4
+//! collapse, as in Embree). Every binary leaf becomes one leaf slot of a wide node, with the
+//! same primitives; children keep their left-to-right order. A pure function of the binary
+//! tree, so the wide tree is as deterministic as the binary one.
+
+use super::build::BinaryNode;
+use super::{BvhNode, WIDTH};
+use super::super::real::Real;
+
+/// The wide nodes in depth-first order (a node's first interior child follows it), root first.
+pub(super) fn collapse(binary: &[BinaryNode]) -> Vec<BvhNode> {
+    let mut nodes = Vec::with_capacity(binary.len() / 2 + 1);
+    if !binary.is_empty() {
+        emit(binary, 0, &mut nodes);
+    }
+    nodes
+}
+
+/// Appends the wide node standing for binary node `index` and then, depth first, the wide
+/// nodes of its interior children; returns the node's index.
+fn emit(binary: &[BinaryNode], index: usize, nodes: &mut Vec<BvhNode>) -> u32 {
+    let (slots, len) = children(binary, index);
+    let at = nodes.len();
+    nodes.push(BvhNode::EMPTY);
+    for (lane, &child) in slots[..len].iter().enumerate() {
+        let node = &binary[child];
+        let target = if node.is_leaf() { node.offset } else { emit(binary, child, nodes) };
+        nodes[at].set_child(lane, &node.bounds, target, node.prim_count);
+    }
+    at as u32
+}
+
+/// The binary nodes that become the children of the wide node for `index`, in tree order. A
+/// binary tree that is a single leaf becomes one wide node with that leaf as its only child.
+fn children(binary: &[BinaryNode], index: usize) -> ([usize; WIDTH], usize) {
+    let mut slots = [index; WIDTH];
+    let node = &binary[index];
+    if node.is_leaf() {
+        return (slots, 1);
+    }
+    // Depth-first storage: the first child follows its parent, `offset` is the second.
+    (slots[0], slots[1]) = (index + 1, node.offset as usize);
+    let mut len = 2;
+    while len < WIDTH {
+        let widest = (0..len)
+            .filter(|&k| !binary[slots[k]].is_leaf())
+            .max_by(|&a, &b| area(binary, slots[a]).total_cmp(&area(binary, slots[b])).then(b.cmp(&a)));
+        let Some(k) = widest else { break };
+        let opened = slots[k];
+        slots.copy_within(k + 1..len, k + 2);
+        (slots[k], slots[k + 1]) = (opened + 1, binary[opened].offset as usize);
+        len += 1;
+    }
+    (slots, len)
+}
+
+fn area(binary: &[BinaryNode], index: usize) -> Real {
+    binary[index].bounds.surface_area()
+}
