@@ -3,7 +3,7 @@
 //! - `primary_rays/blob_1.3M`: camera rays into a 1,310,720-triangle mesh that fills the frame,
 //!   on one thread (per-core figure) and on two; criterion reports rays/s as elements/s.
 //! - `incoherent_rays/blob_1.3M`: closest hits of rays with random origins in the cube around the
-//!   same mesh (about half inside it) and random directions, from a stateless hash, on one and
+//!   same mesh (about one in six inside it) and random directions, from a stateless hash, on one and
 //!   two threads: the memory-bound case of secondary rays, with no two rays alike.
 //! - `bvh_build/blob_1.3M`: the binned-SAH build over that mesh's triangle boxes, on one and two
 //!   threads.
@@ -114,7 +114,8 @@ fn uniform(index: u64, stream: u64) -> Real {
 }
 
 /// Origins uniform in the cube [−1.5, 1.5]³ around the blob (radius about 0.75 to 1.25), so
-/// that some start inside it and some outside, and directions uniform on the sphere.
+/// that some start inside it (about one in six) and most outside, and directions uniform on the
+/// sphere.
 fn incoherent_ray(index: u64) -> Ray {
     let origin = Vec3::new(uniform(index, 0), uniform(index, 1), uniform(index, 2)) * 3.0 - Vec3::splat(1.5);
     let z = 2.0 * uniform(index, 3) - 1.0;
