@@ -24,6 +24,16 @@ pub enum Filter {
     Gaussian,
 }
 
+impl Filter {
+    /// The name a case file uses.
+    pub fn name(self) -> &'static str {
+        match self {
+            Filter::None => "none",
+            Filter::Gaussian => "gaussian",
+        }
+    }
+}
+
 /// The floating-point type of all geometry and shading. The film is `f32` either way, because
 /// that is what the EXR holds; `F64` buys accuracy far from the origin or across extreme scales
 /// with speed (see README, "Numerical stability").

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use super::spec::{BackgroundSpec, Case, LightSpec, ObjectSpec, ShapeSpec, TransformOp};
 use super::{LoadOptions, parse};
 use crate::film::Tonemap;
-use crate::options::{Filter, Profile};
+use crate::options::Profile;
 
 /// `toml_path` is where the file will live: asset paths are written relative to its directory
 /// (or absolute when the two share nothing but the root), as the loader resolves them.
@@ -116,7 +116,7 @@ impl Writer<'_> {
             (
                 "filter",
                 r.filter != d.filter,
-                string(filter_name(r.filter)),
+                string(r.filter.name()),
             ),
             (
                 "depth_range",
@@ -394,12 +394,6 @@ fn profile_name(profile: Profile) -> &'static str {
     }
 }
 
-fn filter_name(filter: Filter) -> &'static str {
-    match filter {
-        Filter::None => "none",
-        Filter::Gaussian => "gaussian",
-    }
-}
 
 fn tonemap_name(tonemap: Tonemap) -> &'static str {
     match tonemap {

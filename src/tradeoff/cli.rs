@@ -7,7 +7,7 @@ use std::time::Duration;
 use super::error::TradeoffError;
 use super::measure::Metric;
 use super::report::significant;
-use super::sweep::{DEFAULT_FILTERS, SweepPlan, filter_name};
+use super::sweep::{DEFAULT_FILTERS, SweepPlan};
 use super::{Tradeoff, TradeoffOptions, run_tradeoff};
 use crate::case::{MAX_BOUNCES, MAX_IMAGE_SIZE, case_name};
 use crate::options::{Filter, Precision};
@@ -32,7 +32,7 @@ pub struct TradeoffArgs {
     pub samples: Vec<u32>,
     /// Filters of the grid: comma-separated, from none and gaussian (3× supersampling, 9× the rays).
     #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_filter,
-          default_values = DEFAULT_FILTERS.map(filter_name))]
+          default_values = DEFAULT_FILTERS.map(Filter::name))]
     pub filters: Vec<Filter>,
     /// Precisions of the grid: comma-separated, from f32 and f64 (the reference is always f64).
     #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_precision,

@@ -16,7 +16,6 @@ use plotters::style::{FontStyle, register_font};
 use super::Tradeoff;
 use super::error::TradeoffError;
 use super::measure::Measurement;
-use super::sweep::filter_name;
 
 /// The PNG's `Software` text, by which a later run recognises its own plot.
 pub const SOFTWARE: &str = "goldray tradeoff";
@@ -115,7 +114,7 @@ fn curves(t: &Tradeoff, floor: (f64, f64)) -> Vec<Curve> {
             name: format!(
                 "{}, filter {}, {} bounces: samples per pixel",
                 precision.name(),
-                filter_name(filter),
+                filter.name(),
                 t.bounces.enough()
             ),
             points: members.iter().map(|m| (position(m, t, floor), m.setting.samples.to_string())).collect(),
@@ -130,7 +129,7 @@ fn curves(t: &Tradeoff, floor: (f64, f64)) -> Vec<Curve> {
             t.base.precision.name(),
             t.bounces.last,
             t.base.samples,
-            filter_name(t.base.filter)
+            t.base.filter.name()
         ),
         points: bounces.iter().map(|m| (position(m, t, floor), format!("b{}", m.setting.bounces))).collect(),
         dashed: true,

@@ -16,7 +16,6 @@ use super::error::TradeoffError;
 use super::measure::Measurement;
 use super::pareto::SAME_ERROR;
 use super::plot::{SOFTWARE, is_our_png, plot_png};
-use super::sweep::filter_name;
 use crate::film::write_file_atomic;
 use crate::stats::grouped;
 
@@ -112,7 +111,7 @@ pub fn csv(tradeoff: &Tradeoff) -> String {
             "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
             s.label(),
             s.samples,
-            filter_name(s.filter),
+            s.filter.name(),
             s.precision.name(),
             s.bounces,
             sweeps(m),
@@ -176,7 +175,7 @@ pub fn markdown(t: &Tradeoff) -> String {
             "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
             s.label(),
             s.samples,
-            filter_name(s.filter),
+            s.filter.name(),
             s.precision.name(),
             s.bounces,
             significant(m.seconds),
@@ -215,7 +214,7 @@ pub fn bounce_sentence(t: &Tradeoff) -> String {
     let of = format!(
         "at the case's {} spp, filter {}, {}",
         t.base.samples,
-        filter_name(t.base.filter),
+        t.base.filter.name(),
         t.base.precision.name()
     );
     let asks = format!("The case asks for {}.", plural(t.base.bounces, "bounce"));

@@ -42,7 +42,7 @@ impl Setting {
 
     /// A short name without commas (it is a CSV field and a plot label): `16spp gaussian 2b f32`.
     pub fn label(&self) -> String {
-        format!("{}spp {} {}b {}", self.samples, filter_name(self.filter), self.bounces, self.precision.name())
+        format!("{}spp {} {}b {}", self.samples, self.filter.name(), self.bounces, self.precision.name())
     }
 
     /// Camera rays per output pixel: the part of the cost known before rendering, which weighs
@@ -66,13 +66,6 @@ impl Setting {
     }
 }
 
-/// The name a case file uses for a filter.
-pub fn filter_name(filter: Filter) -> &'static str {
-    match filter {
-        Filter::None => "none",
-        Filter::Gaussian => "gaussian",
-    }
-}
 
 /// The grid's filters unless told otherwise: both, since the filter is the costliest choice.
 pub const DEFAULT_FILTERS: [Filter; 2] = [Filter::None, Filter::Gaussian];
