@@ -22,7 +22,6 @@ use std::path::Path;
 use std::sync::{Arc, LazyLock};
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use rayon::prelude::*;
 use goldray::case::{AssignmentOptions, LoadOptions, load, load_assignment_scene};
 use goldray::film::{Tonemap, color_image, depth_image, encode_png, normals_image};
 use goldray::geometry::Ray;
@@ -30,15 +29,16 @@ use goldray::geometry::aabb::Aabb;
 use goldray::geometry::bvh::Bvh;
 use goldray::geometry::generate::{blob, write_obj};
 use goldray::geometry::mesh::{Mesh, VertexNormals};
+use goldray::options::{Filter, Profile, RenderOptions, Spawn};
 use goldray::pipeline::{render_case, render_options};
+use goldray::progress::Progress;
 use goldray::real::{Color, Real, Vec3};
 use goldray::render::camera::Camera;
 use goldray::render::light::Light;
 use goldray::render::material::Material;
-use goldray::options::{Filter, Profile, RenderOptions, Spawn};
-use goldray::progress::Progress;
 use goldray::render::{render, render_counting_rays};
 use goldray::scene::{Aggregate, Background, Object, Scene, Shape, build_scene};
+use rayon::prelude::*;
 
 const SIDE: u32 = 256;
 /// Rays per iteration of the incoherent benchmark: enough that each thread gets many chunks.
@@ -64,7 +64,11 @@ fn blob_scene() -> Scene {
 }
 
 fn blob_scene_lit(lights: Vec<Light>) -> Scene {
-    let object = Object { shape: Shape::Mesh(Arc::clone(&BLOB_MESH)), transform: None, material: 0 };
+    let object = Object {
+        shape: Shape::Mesh(Arc::clone(&BLOB_MESH)),
+        transform: None,
+        material: 0,
+    };
     Scene {
         camera: Camera::new(Profile::Native, Vec3::new(0.0, 0.0, 2.6), -Vec3::Z, Vec3::Y, 40.0),
         background: Background::Color(Color::ZERO),
@@ -91,7 +95,10 @@ fn primary_rays(c: &mut Criterion) {
     group.sample_size(10);
     group.throughput(Throughput::Elements(u64::from(SIDE * SIDE)));
     for threads in [1, 2] {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a thread pool");
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a thread pool");
         group.bench_function(format!("blob_1.3M/{threads}_threads"), |b| {
             let scene = blob_scene();
             b.iter(|| pool.install(|| render(&scene, &options, &Progress::hidden())))
@@ -102,7 +109,11 @@ fn primary_rays(c: &mut Criterion) {
 
 /// SplitMix64 of a ray index and one of eight streams: every ray is a pure function of its index.
 fn hash(index: u64, stream: u64) -> u64 {
-    let mut z = index.wrapping_mul(8).wrapping_add(stream).wrapping_add(1).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    let mut z = index
+        .wrapping_mul(8)
+        .wrapping_add(stream)
+        .wrapping_add(1)
+        .wrapping_mul(0x9e37_79b9_7f4a_7c15);
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
     z ^ (z >> 31)
@@ -130,13 +141,21 @@ fn incoherent_rays(c: &mut Criterion) {
     group.sample_size(10);
     group.throughput(Throughput::Elements(INCOHERENT_RAYS as u64));
     for threads in [1, 2] {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a thread pool");
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a thread pool");
         group.bench_function(format!("blob_1.3M/{threads}_threads"), |b| {
             let scene = blob_scene();
             b.iter(|| {
                 pool.install(|| {
                     rays.par_chunks(256)
-                        .map(|chunk| chunk.iter().filter(|ray| scene.geometry.intersect(ray).is_some()).count())
+                        .map(|chunk| {
+                            chunk
+                                .iter()
+                                .filter(|ray| scene.geometry.intersect(ray).is_some())
+                                .count()
+                        })
                         .sum::<usize>()
                 })
             })
@@ -148,14 +167,22 @@ fn incoherent_rays(c: &mut Criterion) {
 fn bvh_build(c: &mut Criterion) {
     let bounds = LazyLock::new(|| {
         let (positions, triangles) = &*BLOB;
-        triangles.iter().map(|corners| Aabb::from_points(corners.map(|i| positions[i as usize]))).collect::<Vec<_>>()
+        triangles
+            .iter()
+            .map(|corners| Aabb::from_points(corners.map(|i| positions[i as usize])))
+            .collect::<Vec<_>>()
     });
     let mut group = c.benchmark_group("bvh_build");
     group.sample_size(10);
     group.throughput(Throughput::Elements(BLOB_TRIANGLES));
     for threads in [1, 2] {
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a thread pool");
-        group.bench_function(format!("blob_1.3M/{threads}_threads"), |b| b.iter(|| pool.install(|| Bvh::build(&bounds))));
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a thread pool");
+        group.bench_function(format!("blob_1.3M/{threads}_threads"), |b| {
+            b.iter(|| pool.install(|| Bvh::build(&bounds)))
+        });
     }
     group.finish();
 }
@@ -164,7 +191,9 @@ fn end_to_end(c: &mut Criterion) {
     let mut group = c.benchmark_group("end_to_end");
     group.sample_size(10);
     for name in ["spheres_shadows", "blob_mesh"] {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases").join(format!("{name}.toml"));
+        let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("cases")
+            .join(format!("{name}.toml"));
         group.bench_function(name, |b| {
             b.iter(|| {
                 let case = load(&path, &LoadOptions::default()).expect("a shipped case loads");
@@ -188,7 +217,10 @@ const COURSE_COMMANDS: [(&str, (f64, f64), u32, bool); 7] = [
 
 fn course_scenes(c: &mut Criterion) {
     let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/mit6837/data");
-    assert!(data.is_dir(), "../shared/mit6837 is missing: the course benchmark needs its scenes");
+    assert!(
+        data.is_dir(),
+        "../shared/mit6837 is missing: the course benchmark needs its scenes"
+    );
     let mut group = c.benchmark_group("course_scenes");
     group.sample_size(10);
     group.bench_function("seven_at_800", |b| {
@@ -203,7 +235,8 @@ fn course_scenes(c: &mut Criterion) {
                     normals: true,
                     ..AssignmentOptions::default()
                 };
-                let case = load_assignment_scene(&data.join(format!("{scene}.txt")), &options).expect("a course scene loads");
+                let case =
+                    load_assignment_scene(&data.join(format!("{scene}.txt")), &options).expect("a course scene loads");
                 let film = render_case(&case, false).expect("a course scene renders");
                 let (min, max) = (depth_range.0 as f32, depth_range.1 as f32);
                 for image in [
@@ -224,7 +257,8 @@ fn course_scenes(c: &mut Criterion) {
 fn ensure_blob_1m(path: &Path) {
     if !path.exists() {
         let (positions, triangles) = &*BLOB;
-        std::fs::create_dir_all(path.parent().expect("the asset has a directory")).expect("cases/bench/assets is writable");
+        std::fs::create_dir_all(path.parent().expect("the asset has a directory"))
+            .expect("cases/bench/assets is writable");
         write_obj(path, positions, triangles).expect("the blob OBJ is written");
     }
 }
@@ -232,7 +266,10 @@ fn ensure_blob_1m(path: &Path) {
 fn stats_overhead(c: &mut Criterion) {
     let cases = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases");
     ensure_blob_1m(&cases.join("bench/assets/blob_1m.obj"));
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("a thread pool");
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("a thread pool");
     let mut group = c.benchmark_group("stats_overhead");
     group.sample_size(10);
     for path in [cases.join("bench/blob_1m.toml"), cases.join("mirrors.toml")] {
@@ -256,7 +293,11 @@ fn stats_overhead(c: &mut Criterion) {
 /// pays for one shadow ray per hit. With 4 samples per pixel, the AOVs cost one more ray per
 /// pixel (5 instead of 4) when they are written and nothing when they are not.
 fn only_what_is_required(c: &mut Criterion) {
-    let light = Light::Point { position: Vec3::new(2.0, 3.0, 5.0), color: Color::ONE, falloff: 0.05 };
+    let light = Light::Point {
+        position: Vec3::new(2.0, 3.0, 5.0),
+        color: Color::ONE,
+        falloff: 0.05,
+    };
     let options = |shadows, samples, aovs| RenderOptions {
         width: SIDE,
         height: SIDE,
@@ -275,7 +316,10 @@ fn only_what_is_required(c: &mut Criterion) {
         ("4_samples_with_aovs", Vec::new(), options(false, 4, true)),
         ("4_samples_without_aovs", Vec::new(), options(false, 4, false)),
     ];
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("a thread pool");
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("a thread pool");
     let mut group = c.benchmark_group("only_what_is_required");
     group.sample_size(10);
     for (name, lights, options) in &renders {

@@ -12,7 +12,11 @@ use goldray::geometry::generate::{blob, write_obj};
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let parsed = match args.as_slice() {
-        [subdivisions, seed, out] => subdivisions.parse::<u32>().ok().zip(seed.parse::<u64>().ok()).map(|(s, seed)| (s, seed, PathBuf::from(out))),
+        [subdivisions, seed, out] => subdivisions
+            .parse::<u32>()
+            .ok()
+            .zip(seed.parse::<u64>().ok())
+            .map(|(s, seed)| (s, seed, PathBuf::from(out))),
         _ => None,
     };
     let Some((subdivisions, seed, out)) = parsed.filter(|(s, _, _)| *s <= 10) else {
@@ -22,7 +26,9 @@ fn main() -> ExitCode {
     let (positions, triangles) = blob(subdivisions, seed);
     // The benchmark mesh goes to cases/bench/assets/, which git ignores and a fresh clone lacks.
     let parent = out.parent().filter(|p| !p.as_os_str().is_empty());
-    let written = parent.map_or(Ok(()), std::fs::create_dir_all).and_then(|()| write_obj(&out, &positions, &triangles));
+    let written = parent
+        .map_or(Ok(()), std::fs::create_dir_all)
+        .and_then(|()| write_obj(&out, &positions, &triangles));
     if let Err(error) = written {
         eprintln!("error: cannot write {}: {error}", out.display());
         return ExitCode::FAILURE;

@@ -9,9 +9,15 @@ use crate::case::SourceLocation;
 #[derive(Debug, thiserror::Error)]
 pub enum BuildError {
     #[error("{location}: cannot load mesh: {source}")]
-    Mesh { location: SourceLocation, source: MeshError },
+    Mesh {
+        location: SourceLocation,
+        source: MeshError,
+    },
     #[error("{location}: {source}")]
-    Transform { location: SourceLocation, source: TransformError },
+    Transform {
+        location: SourceLocation,
+        source: TransformError,
+    },
     #[error("{file}: {source}")]
     CubeMap { file: PathBuf, source: CubeMapError },
 }
@@ -39,10 +45,7 @@ pub enum MeshError {
         normal_count: usize,
     },
     #[error("cannot read {}: {source}", path.display())]
-    Read {
-        path: PathBuf,
-        source: std::io::Error,
-    },
+    Read { path: PathBuf, source: std::io::Error },
     #[error("{}:{line}: {problem}", path.display())]
     Malformed {
         path: PathBuf,
@@ -52,15 +55,9 @@ pub enum MeshError {
     #[error("{}: the file has no faces", path.display())]
     NoFaces { path: PathBuf },
     #[error("{}: the OBJ reader failed: {source}", path.display())]
-    Obj {
-        path: PathBuf,
-        source: tobj::LoadError,
-    },
+    Obj { path: PathBuf, source: tobj::LoadError },
     #[error("{}: {source}", path.display())]
-    InFile {
-        path: PathBuf,
-        source: Box<MeshError>,
-    },
+    InFile { path: PathBuf, source: Box<MeshError> },
 }
 
 /// Why a transform cannot be used.

@@ -1,8 +1,8 @@
 //! The library's top-level error: every stage's error, each of which already names its file.
 
+use crate::build_error::BuildError;
 use crate::case::CaseError;
 use crate::film::OutputError;
-use crate::build_error::BuildError;
 
 #[derive(Debug, thiserror::Error)]
 pub enum Error {

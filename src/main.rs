@@ -164,19 +164,34 @@ fn course_style_flags(args: impl Iterator<Item = OsString>) -> Vec<OsString> {
 fn run(cli: Cli) -> Result<ExitCode, String> {
     match cli.command {
         Command::Render { case, out, run } => {
-            let load = LoadOptions { allow_huge_images: run.force };
+            let load = LoadOptions {
+                allow_huge_images: run.force,
+            };
             let rendered = run.install(|| render_case_file(&case, &out, &load, !run.quiet))?;
             run.report(&rendered).map(|()| ExitCode::SUCCESS)
         }
-        Command::Mit6837 { input, output, normals, depth, exr, course, run } => {
-            let depth = depth.map(|values| parse_depth(&values[..2]).map(|(min, max)| (min, max, PathBuf::from(&values[2])))).transpose()?;
+        Command::Mit6837 {
+            input,
+            output,
+            normals,
+            depth,
+            exr,
+            course,
+            run,
+        } => {
+            let depth = depth
+                .map(|values| parse_depth(&values[..2]).map(|(min, max)| (min, max, PathBuf::from(&values[2]))))
+                .transpose()?;
             let outputs = AssignmentOutputs {
                 color: output,
                 normals,
-                depth: depth.as_ref().map(|(min, max, path)| (*min as f32, *max as f32, path.clone())),
+                depth: depth
+                    .as_ref()
+                    .map(|(min, max, path)| (*min as f32, *max as f32, path.clone())),
                 exr,
             };
-            if outputs.color.is_none() && outputs.normals.is_none() && outputs.depth.is_none() && outputs.exr.is_none() {
+            if outputs.color.is_none() && outputs.normals.is_none() && outputs.depth.is_none() && outputs.exr.is_none()
+            {
                 return Err("nothing to write: give -output, -normals, -depth or --exr".to_string());
             }
             let depth_range = depth.map(|(min, max, _)| (min, max));
@@ -184,7 +199,14 @@ fn run(cli: Cli) -> Result<ExitCode, String> {
             let rendered = run.install(|| render_assignment(&input, &options, &outputs, !run.quiet))?;
             run.report(&rendered).map(|()| ExitCode::SUCCESS)
         }
-        Command::Import { scene, output, force, depth, normals, course } => {
+        Command::Import {
+            scene,
+            output,
+            force,
+            depth,
+            normals,
+            course,
+        } => {
             let depth_range = depth.map(|values| parse_depth(&values)).transpose()?;
             let options = course.options(depth_range, normals, true)?;
             let toml_path = output.clone().unwrap_or_else(|| PathBuf::from("imported.toml"));
@@ -194,15 +216,19 @@ fn run(cli: Cli) -> Result<ExitCode, String> {
                     Err(format!("{} exists; pass --force to replace it", path.display()))
                 }
                 Some(path) => goldray::film::write_file_atomic(&path, text.as_bytes()).map_err(|e| e.to_string()),
-                None => std::io::stdout().write_all(text.as_bytes()).map_err(|e| format!("cannot write to standard output: {e}")),
+                None => std::io::stdout()
+                    .write_all(text.as_bytes())
+                    .map_err(|e| format!("cannot write to standard output: {e}")),
             }
             .map(|()| ExitCode::SUCCESS)
         }
         Command::Diff(args) => Ok(ExitCode::from(goldray::compare::run_diff(&args))),
-        Command::Grade(args) => goldray::grade::run_grade(&args).map(|_| ExitCode::SUCCESS).map_err(|e| e.to_string()),
-        Command::Tradeoff(args) => {
-            goldray::tradeoff::run_tradeoff_command(&args).map(|_| ExitCode::SUCCESS).map_err(|e| e.to_string())
-        }
+        Command::Grade(args) => goldray::grade::run_grade(&args)
+            .map(|_| ExitCode::SUCCESS)
+            .map_err(|e| e.to_string()),
+        Command::Tradeoff(args) => goldray::tradeoff::run_tradeoff_command(&args)
+            .map(|_| ExitCode::SUCCESS)
+            .map_err(|e| e.to_string()),
     }
 }
 
@@ -222,7 +248,12 @@ fn parse_depth(values: &[String]) -> Result<(f64, f64), String> {
 }
 
 impl CourseFlags {
-    fn options(&self, depth_range: Option<(f64, f64)>, normals: bool, allow_huge: bool) -> Result<AssignmentOptions, String> {
+    fn options(
+        &self,
+        depth_range: Option<(f64, f64)>,
+        normals: bool,
+        allow_huge: bool,
+    ) -> Result<AssignmentOptions, String> {
         let (width, height) = (self.size[0], self.size[1]);
         let limit = if allow_huge { u32::MAX } else { MAX_IMAGE_SIZE as u32 };
         if width == 0 || height == 0 || width > limit || height > limit {
@@ -252,7 +283,9 @@ impl RunFlags {
         if let Some(threads) = self.threads {
             builder = builder.num_threads(threads as usize);
         }
-        let pool = builder.build().map_err(|e| format!("cannot start worker threads: {e}"))?;
+        let pool = builder
+            .build()
+            .map_err(|e| format!("cannot start worker threads: {e}"))?;
         pool.install(work).map_err(|e| e.to_string())
     }
 

@@ -137,7 +137,13 @@ fn measured_run(
         write: write_start.elapsed(),
         total: start.elapsed(),
     };
-    let stats = RenderStats::new(&case, phases, measured.build_stats, &measured.rays, rayon::current_num_threads());
+    let stats = RenderStats::new(
+        &case,
+        phases,
+        measured.build_stats,
+        &measured.rays,
+        rayon::current_num_threads(),
+    );
     Ok(Rendered { written, stats })
 }
 

@@ -25,7 +25,12 @@ impl Progress {
             bar.set_style(style.progress_chars("=> "));
         }
         bar.set_message(message.to_string());
-        Progress { bar, enabled, visible: AtomicBool::new(false), started: Instant::now() }
+        Progress {
+            bar,
+            enabled,
+            visible: AtomicBool::new(false),
+            started: Instant::now(),
+        }
     }
 
     pub fn hidden() -> Progress {

@@ -16,8 +16,8 @@ use std::path::{Path, PathBuf};
 
 use glam::DVec3;
 use goldray::case::{
-    AssignmentOptions, Case, CaseError, LightSpec, ObjectSpec, ShapeSpec, SourceLocation,
-    TransformOp, composite_matrix, load_assignment_scene, parse_assignment_scene,
+    AssignmentOptions, Case, CaseError, LightSpec, ObjectSpec, ShapeSpec, SourceLocation, TransformOp,
+    composite_matrix, load_assignment_scene, parse_assignment_scene,
 };
 use goldray::film::Tonemap;
 use goldray::options::{Filter, Profile};
@@ -45,8 +45,7 @@ fn data_dir() -> PathBuf {
 
 fn course_scene(name: &str) -> Case {
     let path = data_dir().join(name);
-    load_assignment_scene(&path, &AssignmentOptions::default())
-        .unwrap_or_else(|e| panic!("{name} must load: {e}"))
+    load_assignment_scene(&path, &AssignmentOptions::default()).unwrap_or_else(|e| panic!("{name} must load: {e}"))
 }
 
 /// Where synthetic scenes claim to live, so that `models/…` and `tex/…` resolve.
@@ -63,8 +62,7 @@ fn parse_ok(source: &str) -> Case {
 }
 
 /// Six lines, so that a synthetic scene's own text starts on line 7.
-const CAMERA: &str =
-    "PerspectiveCamera {\n    center 0 0 10\n    direction 0 0 -1\n    up 0 1 0\n    angle 30\n}\n";
+const CAMERA: &str = "PerspectiveCamera {\n    center 0 0 10\n    direction 0 0 -1\n    up 0 1 0\n    angle 30\n}\n";
 
 fn with_camera(body: &str) -> String {
     format!("{CAMERA}{body}")
@@ -105,10 +103,7 @@ fn all_seven_course_scenes_load_with_the_course_defaults() {
         let case = course_scene(name);
         assert_eq!(case.name, name.trim_end_matches(".txt"));
         let r = &case.render;
-        assert_eq!(
-            (r.width, r.height, r.bounces, r.samples, r.seed),
-            (100, 100, 0, 1, 0)
-        );
+        assert_eq!((r.width, r.height, r.bounces, r.samples, r.seed), (100, 100, 0, 1, 0));
         assert_eq!(
             (r.profile, r.tonemap, r.filter),
             (Profile::Mit6837, Tonemap::Clamp, Filter::None)
@@ -130,10 +125,7 @@ fn scene01_has_five_spheres_a_plane_and_their_material_indices() {
             _ => "other",
         })
         .collect();
-    assert_eq!(
-        kinds,
-        ["sphere", "sphere", "sphere", "sphere", "sphere", "plane"]
-    );
+    assert_eq!(kinds, ["sphere", "sphere", "sphere", "sphere", "sphere", "plane"]);
     let materials: Vec<Option<usize>> = case.objects.iter().map(|o| o.material).collect();
     assert_eq!(materials, [0, 1, 1, 2, 2, 3].map(Some));
     assert_eq!(
@@ -152,10 +144,7 @@ fn scene01_has_five_spheres_a_plane_and_their_material_indices() {
     );
     assert_eq!(case.materials.len(), 4);
     assert_eq!(case.materials[3].name, "material3");
-    assert_eq!(
-        case.materials[3].shininess, 20.0,
-        "`shininess 20}}` keeps its number"
-    );
+    assert_eq!(case.materials[3].shininess, 20.0, "`shininess 20}}` keeps its number");
     assert_eq!(case.materials[1].diffuse, [0.0, 1.0, 0.0]);
     assert_eq!(case.materials[1].specular, [0.0; 3]);
     assert_eq!(case.camera.fov, 30.0);
@@ -198,10 +187,7 @@ fn scene03_lists_its_ops_in_the_written_order() {
     let sphere = &case.objects[0];
     assert_eq!(
         sphere.transform,
-        [
-            TransformOp::RotateZ(45.0),
-            TransformOp::Scale([1.0, 0.2, 1.0])
-        ]
+        [TransformOp::RotateZ(45.0), TransformOp::Scale([1.0, 0.2, 1.0])]
     );
     assert_eq!(sphere.material, Some(0));
     assert_eq!(case.camera.fov, 20.0);
@@ -255,11 +241,7 @@ fn scenes_06_and_07_resolve_their_cube_map_and_drop_the_colour_it_replaces() {
         assert_eq!(case.background.ambient, [0.1; 3], "{name}");
     }
     let case = course_scene("scene06_bunny_1k.txt");
-    assert_eq!(
-        case.materials[0].diffuse,
-        [0.2, 0.2, 0.3],
-        "fields in any order"
-    );
+    assert_eq!(case.materials[0].diffuse, [0.2, 0.2, 0.3], "fields in any order");
     assert_eq!(case.materials[0].shininess, 30.0);
 }
 
@@ -296,25 +278,16 @@ fn without_lights_the_ambient_light_is_white_whatever_the_file_says() {
     let no_block = parse_ok(&with_camera(&format!("{background}{group}")));
     assert_eq!(no_block.background.ambient, [1.0; 3]);
     assert!(no_block.lights.is_empty());
-    let zero = parse_ok(&with_camera(&format!(
-        "Lights {{ numLights 0 }}\n{background}{group}"
-    )));
+    let zero = parse_ok(&with_camera(&format!("Lights {{ numLights 0 }}\n{background}{group}")));
     assert_eq!(zero.background.ambient, [1.0; 3]);
-    let lit = format!(
-        "Lights {{ numLights 1 DirectionalLight {{ direction 0 0 -1 color 1 1 1 }} }}\n{background}{group}"
-    );
-    assert_eq!(
-        parse_ok(&with_camera(&lit)).background.ambient,
-        [0.1, 0.2, 0.3]
-    );
+    let lit =
+        format!("Lights {{ numLights 1 DirectionalLight {{ direction 0 0 -1 color 1 1 1 }} }}\n{background}{group}");
+    assert_eq!(parse_ok(&with_camera(&lit)).background.ambient, [0.1, 0.2, 0.3]);
 }
 
 #[test]
 fn missing_optional_blocks_take_the_course_defaults() {
-    let case = parse_ok(&with_camera(&format!(
-        "Group {{ numObjects 1 {} }}",
-        sphere("0 0 0")
-    )));
+    let case = parse_ok(&with_camera(&format!("Group {{ numObjects 1 {} }}", sphere("0 0 0"))));
     assert_eq!(case.background.color, [0.5; 3]);
     assert!(case.materials.is_empty());
     assert_eq!(case.objects[0].material, None, "no MaterialIndex yet");
@@ -351,13 +324,7 @@ fn the_flags_become_render_settings() {
         ..options.clone()
     };
     let message = load_assignment_scene(&path, &bad).unwrap_err().to_string();
-    assert!(
-        message.contains("-depth 18 8: needs finite min < max"),
-        "{message}"
-    );
-    let bad = AssignmentOptions {
-        width: 0,
-        ..options
-    };
+    assert!(message.contains("-depth 18 8: needs finite min < max"), "{message}");
+    let bad = AssignmentOptions { width: 0, ..options };
     assert!(load_assignment_scene(&path, &bad).is_err());
 }

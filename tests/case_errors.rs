@@ -17,8 +17,7 @@ use std::path::{Path, PathBuf};
 
 use goldray::case::{Case, CaseError, LoadOptions, parse};
 
-const CAMERA: &str =
-    "[camera]\ncenter = [0, 0, 10]\ndirection = [0, 0, -1]\nup = [0, 1, 0]\nfov = 30\n";
+const CAMERA: &str = "[camera]\ncenter = [0, 0, 10]\ndirection = [0, 0, -1]\nup = [0, 1, 0]\nfov = 30\n";
 
 fn try_parse(source: &str) -> Result<Case, CaseError> {
     parse(source, Path::new("cases/x.toml"), &LoadOptions::default())
@@ -39,10 +38,7 @@ fn assert_error(message: &str, location: &str, fragments: &[&str]) {
         "expected location {location} in: {message}"
     );
     for fragment in fragments {
-        assert!(
-            message.contains(fragment),
-            "expected {fragment:?} in: {message}"
-        );
+        assert!(message.contains(fragment), "expected {fragment:?} in: {message}");
     }
 }
 

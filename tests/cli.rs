@@ -6,7 +6,10 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn goldray(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_goldray")).args(args).output().expect("the goldray binary runs")
+    Command::new(env!("CARGO_BIN_EXE_goldray"))
+        .args(args)
+        .output()
+        .expect("the goldray binary runs")
 }
 
 fn case(name: &str) -> PathBuf {
@@ -19,7 +22,9 @@ fn stderr(output: &Output) -> String {
 
 fn files_in(dir: &Path) -> Vec<String> {
     let mut names: Vec<String> = match fs::read_dir(dir) {
-        Ok(entries) => entries.map(|e| e.unwrap().file_name().to_string_lossy().into_owned()).collect(),
+        Ok(entries) => entries
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect(),
         Err(_) => Vec::new(),
     };
     names.sort();
@@ -29,7 +34,13 @@ fn files_in(dir: &Path) -> Vec<String> {
 #[test]
 fn render_writes_exr_and_png_named_after_the_case() {
     let out = tempfile::tempdir().unwrap();
-    let result = goldray(&["render", case("directional_light.toml").to_str().unwrap(), "--out", out.path().to_str().unwrap(), "--quiet"]);
+    let result = goldray(&[
+        "render",
+        case("directional_light.toml").to_str().unwrap(),
+        "--out",
+        out.path().to_str().unwrap(),
+        "--quiet",
+    ]);
     assert!(result.status.success(), "{}", stderr(&result));
     assert_eq!(files_in(out.path()), ["directional_light.exr", "directional_light.png"]);
     let png = image::open(out.path().join("directional_light.png")).unwrap();
@@ -39,22 +50,44 @@ fn render_writes_exr_and_png_named_after_the_case() {
 #[test]
 fn depth_and_normal_images_are_written_when_the_case_asks() {
     let out = tempfile::tempdir().unwrap();
-    let result = goldray(&["render", case("depth_normals.toml").to_str().unwrap(), "--out", out.path().to_str().unwrap(), "--quiet"]);
+    let result = goldray(&[
+        "render",
+        case("depth_normals.toml").to_str().unwrap(),
+        "--out",
+        out.path().to_str().unwrap(),
+        "--quiet",
+    ]);
     assert!(result.status.success(), "{}", stderr(&result));
     assert_eq!(
         files_in(out.path()),
-        ["depth_normals.exr", "depth_normals.png", "depth_normals_depth.png", "depth_normals_normals.png"]
+        [
+            "depth_normals.exr",
+            "depth_normals.png",
+            "depth_normals_depth.png",
+            "depth_normals_normals.png"
+        ]
     );
 }
 
 #[test]
 fn exr_is_bit_identical_with_one_and_two_threads() {
-    for name in ["jitter_filter.toml", "mirrors.toml", "nested_groups.toml", "blob_mesh.toml"] {
+    for name in [
+        "jitter_filter.toml",
+        "mirrors.toml",
+        "nested_groups.toml",
+        "blob_mesh.toml",
+    ] {
         let mut bytes = Vec::new();
         for threads in ["1", "2"] {
             let out = tempfile::tempdir().unwrap();
             let result = goldray(&[
-                "render", case(name).to_str().unwrap(), "--out", out.path().to_str().unwrap(), "--threads", threads, "--quiet",
+                "render",
+                case(name).to_str().unwrap(),
+                "--out",
+                out.path().to_str().unwrap(),
+                "--threads",
+                threads,
+                "--quiet",
             ]);
             assert!(result.status.success(), "{name}: {}", stderr(&result));
             let stem = name.trim_end_matches(".toml");
@@ -99,10 +132,23 @@ fn huge_images_need_force() {
     let case_path = dir.path().join("huge.toml");
     fs::write(&case_path, "[render]\nsize = [20000, 1]\n\n[camera]\ncenter = [0, 0, 10]\ndirection = [0, 0, -1]\nup = [0, 1, 0]\nfov = 30\n").unwrap();
     let out = dir.path().join("out");
-    let refused = goldray(&["render", case_path.to_str().unwrap(), "--out", out.to_str().unwrap(), "--quiet"]);
+    let refused = goldray(&[
+        "render",
+        case_path.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
     assert_eq!(refused.status.code(), Some(1));
     assert!(stderr(&refused).contains("--force"), "{}", stderr(&refused));
-    let forced = goldray(&["render", case_path.to_str().unwrap(), "--out", out.to_str().unwrap(), "--quiet", "--force"]);
+    let forced = goldray(&[
+        "render",
+        case_path.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+        "--force",
+    ]);
     assert!(forced.status.success(), "{}", stderr(&forced));
     assert_eq!(image::open(out.join("huge.png")).unwrap().width(), 20000);
 }

@@ -9,9 +9,7 @@ mod diff_cli;
 use std::path::Path;
 
 use goldray::case::{Case, LoadOptions, Tolerance, load, parse};
-use goldray::compare::{
-    Comparison, EXR_DEFAULTS, FAILING, Image, Limit, NON_FINITE, Verdict, compare, diff_heatmap,
-};
+use goldray::compare::{Comparison, EXR_DEFAULTS, FAILING, Image, Limit, NON_FINITE, Verdict, compare, diff_heatmap};
 use goldray::film::Film;
 use goldray::pipeline::render_case;
 
@@ -57,10 +55,7 @@ fn assert_fails_on(comparison: &Comparison, limit: Limit) {
         "expected {} to break:\n{report}",
         limit.name()
     );
-    assert!(
-        report.contains(&format!("broke {}", limit.name())),
-        "{report}"
-    );
+    assert!(report.contains(&format!("broke {}", limit.name())), "{report}");
     assert_eq!(comparison.verdict.exit_code(), 2, "{report}");
 }
 
@@ -181,15 +176,10 @@ fn fails_a_single_nan_pixel_whatever_the_tolerance() {
         let comparison = judge(&golden, &broken, &tolerance);
         assert_fails_on(&comparison, Limit::NonFinite);
         assert!(
-            comparison
-                .to_string()
-                .contains("pixel (17, 23) R: expected"),
+            comparison.to_string().contains("pixel (17, 23) R: expected"),
             "{comparison}"
         );
-        assert!(
-            comparison.to_string().contains("actual NaN"),
-            "{comparison}"
-        );
+        assert!(comparison.to_string().contains("actual NaN"), "{comparison}");
     }
     let reversed = judge(&broken, &golden, &EXR_DEFAULTS);
     assert_fails_on(&reversed, Limit::NonFinite);
@@ -211,10 +201,7 @@ fn an_infinite_colour_fails_but_a_depth_that_turns_into_a_miss_is_only_a_failing
     missed.depth[hit] = f32::INFINITY;
     let comparison = judge(&golden, &missed, &EXR_DEFAULTS);
     assert_eq!(comparison.verdict, Verdict::Warn, "{comparison}");
-    assert!(
-        comparison.to_string().contains("Z fails on 1 pixels"),
-        "{comparison}"
-    );
+    assert!(comparison.to_string().contains("Z fails on 1 pixels"), "{comparison}");
 }
 
 #[test]
@@ -223,16 +210,11 @@ fn reports_a_size_change_as_a_mismatch() {
     let mut wider = golden.clone();
     wider.render.width += 1;
     let comparison = judge(&render(&golden), &render(&wider), &EXR_DEFAULTS);
-    assert!(
-        matches!(comparison.verdict, Verdict::Mismatch { .. }),
-        "{comparison}"
-    );
+    assert!(matches!(comparison.verdict, Verdict::Mismatch { .. }), "{comparison}");
     assert_eq!(comparison.verdict.exit_code(), 3);
     assert!(comparison.metrics.is_none());
     assert!(
-        comparison
-            .to_string()
-            .contains("size differ: expected 160x120"),
+        comparison.to_string().contains("size differ: expected 160x120"),
         "{comparison}"
     );
 }
@@ -246,10 +228,7 @@ fn a_few_pixels_over_the_threshold_warn_and_a_hard_max_fails_them() {
     let comparison = judge(&golden, &touched, &EXR_DEFAULTS);
     assert_eq!(comparison.verdict, Verdict::Warn, "{comparison}");
     assert!(comparison.verdict.accepts());
-    assert!(
-        comparison.to_string().contains("pixel (80, 60) G"),
-        "{comparison}"
-    );
+    assert!(comparison.to_string().contains("pixel (80, 60) G"), "{comparison}");
 
     let capped = Tolerance {
         max: Some(0.02),
@@ -267,12 +246,8 @@ fn the_heatmap_marks_failing_pixels_and_non_finite_values_in_their_own_colours()
     changed.color[failing][0] += 0.5;
     changed.color[nan][1] = f32::NAN;
     changed.color[tiny][2] += 0.001;
-    let heatmap = diff_heatmap(
-        &Image::from_film(&golden, "a"),
-        &Image::from_film(&changed, "b"),
-        0.01,
-    )
-    .expect("same size");
+    let heatmap =
+        diff_heatmap(&Image::from_film(&golden, "a"), &Image::from_film(&changed, "b"), 0.01).expect("same size");
     assert_eq!(heatmap.get_pixel(3, 4).0, FAILING);
     assert_eq!(heatmap.get_pixel(10, 4).0, NON_FINITE);
     let [r, g, b] = heatmap.get_pixel(20, 4).0;
@@ -282,11 +257,7 @@ fn the_heatmap_marks_failing_pixels_and_non_finite_values_in_their_own_colours()
         [r, g, b]
     );
     let [r, g, b] = heatmap.get_pixel(30, 4).0;
-    assert!(
-        r == g && g == b,
-        "an unchanged pixel is grey: {:?}",
-        [r, g, b]
-    );
+    assert!(r == g && g == b, "an unchanged pixel is grey: {:?}", [r, g, b]);
 }
 
 #[test]
@@ -306,9 +277,7 @@ fn a_nan_limit_is_the_strictest_rather_than_no_limit() {
 
 #[test]
 fn the_command_line_defaults_are_the_case_file_defaults() {
-    let minimal =
-        "[camera]\ncenter = [0, 0, 10]\ndirection = [0, 0, -1]\nup = [0, 1, 0]\nfov = 30\n";
-    let case = parse(minimal, Path::new("x.toml"), &LoadOptions::default())
-        .unwrap_or_else(|e| panic!("{e}"));
+    let minimal = "[camera]\ncenter = [0, 0, 10]\ndirection = [0, 0, -1]\nup = [0, 1, 0]\nfov = 30\n";
+    let case = parse(minimal, Path::new("x.toml"), &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(case.tolerance, EXR_DEFAULTS);
 }

@@ -21,8 +21,15 @@ fn shared() -> PathBuf {
 }
 
 fn goldray(args: &[&str]) -> Output {
-    let output = Command::new(env!("CARGO_BIN_EXE_goldray")).args(args).output().expect("the goldray binary runs");
-    assert!(output.status.success(), "goldray {args:?}: {}", String::from_utf8_lossy(&output.stderr));
+    let output = Command::new(env!("CARGO_BIN_EXE_goldray"))
+        .args(args)
+        .output()
+        .expect("the goldray binary runs");
+    assert!(
+        output.status.success(),
+        "goldray {args:?}: {}",
+        String::from_utf8_lossy(&output.stderr)
+    );
     output
 }
 
@@ -32,7 +39,11 @@ fn agreement(ours: &RgbImage, reference: &RgbImage, tolerance: u8) -> (f64, Vec<
     assert_eq!(ours.dimensions(), reference.dimensions());
     let off: Vec<(u32, u32)> = ours
         .enumerate_pixels()
-        .filter(|(x, y, p)| p.0.iter().zip(reference.get_pixel(*x, *y).0).any(|(a, b)| a.abs_diff(b) > tolerance))
+        .filter(|(x, y, p)| {
+            p.0.iter()
+                .zip(reference.get_pixel(*x, *y).0)
+                .any(|(a, b)| a.abs_diff(b) > tolerance)
+        })
         .map(|(x, y, _)| (x, y))
         .collect();
     (1.0 - off.len() as f64 / (ours.width() * ours.height()) as f64, off)
@@ -40,17 +51,33 @@ fn agreement(ours: &RgbImage, reference: &RgbImage, tolerance: u8) -> (f64, Vec<
 
 fn check_against_reference(scene: &str, reference: &str, depth_range: (f64, f64)) {
     let shared = shared();
-    let options = AssignmentOptions { width: 800, height: 800, depth_range: Some(depth_range), normals: true, ..AssignmentOptions::default() };
+    let options = AssignmentOptions {
+        width: 800,
+        height: 800,
+        depth_range: Some(depth_range),
+        normals: true,
+        ..AssignmentOptions::default()
+    };
     let case = load_assignment_scene(&shared.join("data").join(scene), &options).unwrap_or_else(|e| panic!("{e}"));
     let film = render_case(&case, false).unwrap_or_else(|e| panic!("{e}"));
     let (min, max) = (depth_range.0 as f32, depth_range.1 as f32);
     let images = [
         ("colour", color_image(&film, Tonemap::Clamp), format!("{reference}.png")),
-        ("normals", normals_image(&film, Tonemap::Clamp), format!("{reference}n.png")),
-        ("depth", depth_image(&film, min, max, Tonemap::Clamp), format!("{reference}d.png")),
+        (
+            "normals",
+            normals_image(&film, Tonemap::Clamp),
+            format!("{reference}n.png"),
+        ),
+        (
+            "depth",
+            depth_image(&film, min, max, Tonemap::Clamp),
+            format!("{reference}d.png"),
+        ),
     ];
     for (what, ours, file) in images {
-        let expected = image::open(shared.join("reference").join(&file)).unwrap_or_else(|e| panic!("{file}: {e}")).into_rgb8();
+        let expected = image::open(shared.join("reference").join(&file))
+            .unwrap_or_else(|e| panic!("{file}: {e}"))
+            .into_rgb8();
         let (fraction, off) = agreement(&ours, &expected, 2);
         assert!(
             fraction >= 0.995,
@@ -58,7 +85,12 @@ fn check_against_reference(scene: &str, reference: &str, depth_range: (f64, f64)
             fraction * 100.0,
             &off[..off.len().min(10)]
         );
-        eprintln!("{scene} {what}: {:.4}% within 2/255 ({} pixels off: {:?})", fraction * 100.0, off.len(), &off[..off.len().min(8)]);
+        eprintln!(
+            "{scene} {what}: {:.4}% within 2/255 ({} pixels off: {:?})",
+            fraction * 100.0,
+            off.len(),
+            &off[..off.len().min(8)]
+        );
     }
 }
 
@@ -96,7 +128,15 @@ fn drop_in_command_and_imported_case_give_identical_files() {
         let input = shared.join("data").join(format!("{scene}.txt"));
         let at = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
 
-        let mut course = vec!["mit6837", "-input", input.to_str().unwrap(), "-size", "200", "200", "--quiet"];
+        let mut course = vec![
+            "mit6837",
+            "-input",
+            input.to_str().unwrap(),
+            "-size",
+            "200",
+            "200",
+            "--quiet",
+        ];
         let (depth_min, depth_max) = (flags[1], flags[2]);
         let (output, normals, depth, exr) = (at("a.png"), at("an.png"), at("ad.png"), at("a.exr"));
         course.extend(["-output", &output, "-normals", &normals, "--exr", &exr]);
@@ -105,18 +145,44 @@ fn drop_in_command_and_imported_case_give_identical_files() {
         goldray(&course);
 
         let toml = at("imported.toml");
-        let mut import = vec!["import", input.to_str().unwrap(), "-o", &toml, "--size", "200", "200", "--normals"];
+        let mut import = vec![
+            "import",
+            input.to_str().unwrap(),
+            "-o",
+            &toml,
+            "--size",
+            "200",
+            "200",
+            "--normals",
+        ];
         import.extend(["--depth", depth_min, depth_max]);
-        let double_dash: Vec<String> = flags[3..].iter().map(|f| if f.starts_with('-') { format!("-{f}") } else { f.to_string() }).collect();
+        let double_dash: Vec<String> = flags[3..]
+            .iter()
+            .map(|f| {
+                if f.starts_with('-') {
+                    format!("-{f}")
+                } else {
+                    f.to_string()
+                }
+            })
+            .collect();
         import.extend(double_dash.iter().map(String::as_str));
         goldray(&import);
         let out = at("out");
         goldray(&["render", &toml, "--out", &out, "--quiet"]);
 
-        for (course_file, case_file) in [("a.exr", "imported.exr"), ("a.png", "imported.png"), ("an.png", "imported_normals.png"), ("ad.png", "imported_depth.png")] {
+        for (course_file, case_file) in [
+            ("a.exr", "imported.exr"),
+            ("a.png", "imported.png"),
+            ("an.png", "imported_normals.png"),
+            ("ad.png", "imported_depth.png"),
+        ] {
             let a = fs::read(dir.path().join(course_file)).unwrap();
             let b = fs::read(dir.path().join("out").join(case_file)).unwrap();
-            assert!(a == b, "{scene}: {course_file} from `goldray mit6837` differs from {case_file} of the imported case");
+            assert!(
+                a == b,
+                "{scene}: {course_file} from `goldray mit6837` differs from {case_file} of the imported case"
+            );
         }
     }
 }
@@ -126,17 +192,44 @@ fn the_course_command_line_rejects_what_the_course_binary_would() {
     let shared = shared();
     let input = shared.join("data/scene01_plane.txt");
     let run = |args: &[&str]| Command::new(env!("CARGO_BIN_EXE_goldray")).args(args).output().unwrap();
-    let unknown = run(&["mit6837", "-input", input.to_str().unwrap(), "-output", "x.png", "-antialias"]);
+    let unknown = run(&[
+        "mit6837",
+        "-input",
+        input.to_str().unwrap(),
+        "-output",
+        "x.png",
+        "-antialias",
+    ]);
     assert!(!unknown.status.success());
     assert!(String::from_utf8_lossy(&unknown.stderr).contains("antialias"));
-    let zero = run(&["mit6837", "-input", input.to_str().unwrap(), "-output", "x.png", "-size", "0", "10"]);
+    let zero = run(&[
+        "mit6837",
+        "-input",
+        input.to_str().unwrap(),
+        "-output",
+        "x.png",
+        "-size",
+        "0",
+        "10",
+    ]);
     assert_eq!(zero.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&zero.stderr).contains("size 0 10"));
     let no_input = run(&["mit6837", "-output", "x.png"]);
     assert!(!no_input.status.success());
-    let bad_depth = run(&["mit6837", "-input", input.to_str().unwrap(), "-depth", "18", "8", "d.png"]);
+    let bad_depth = run(&[
+        "mit6837",
+        "-input",
+        input.to_str().unwrap(),
+        "-depth",
+        "18",
+        "8",
+        "d.png",
+    ]);
     assert_eq!(bad_depth.status.code(), Some(1));
-    assert!(!Path::new("x.png").exists() && !Path::new("d.png").exists(), "failed commands write nothing");
+    assert!(
+        !Path::new("x.png").exists() && !Path::new("d.png").exists(),
+        "failed commands write nothing"
+    );
 }
 
 #[test]
@@ -152,6 +245,12 @@ fn import_refuses_to_overwrite_without_force() {
         .unwrap();
     assert_eq!(refused.status.code(), Some(1));
     assert_eq!(fs::read_to_string(&target).unwrap(), "# my own notes\n");
-    goldray(&["import", input.to_str().unwrap(), "-o", target.to_str().unwrap(), "--force"]);
+    goldray(&[
+        "import",
+        input.to_str().unwrap(),
+        "-o",
+        target.to_str().unwrap(),
+        "--force",
+    ]);
     assert!(fs::read_to_string(&target).unwrap().contains("profile = \"mit6837\""));
 }

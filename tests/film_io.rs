@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 
 use exr::prelude::{ReadChannels, ReadLayers};
 use goldray::film::{
-    Film, OutputError, OutputOptions, Tonemap, decode_exr, encode_exr, read_exr, write_exr,
-    write_file_atomic, write_outputs,
+    Film, OutputError, OutputOptions, Tonemap, decode_exr, encode_exr, read_exr, write_exr, write_file_atomic,
+    write_outputs,
 };
 
 /// A non-square film (height not a multiple of the 16-line ZIP block) with values that a lossy or
@@ -25,16 +25,8 @@ fn varied_film(seed: u32) -> Film {
     };
     for i in 0..film.color.len() {
         film.color[i] = [next() * 3.0, next() * 1e-30, -next() * 1e6];
-        film.depth[i] = if i % 5 == 0 {
-            f32::INFINITY
-        } else {
-            0.1 + next() * 1e4
-        };
-        film.normal[i] = if i % 5 == 0 {
-            [0.0; 3]
-        } else {
-            [next(), -0.0, -next()]
-        };
+        film.depth[i] = if i % 5 == 0 { f32::INFINITY } else { 0.1 + next() * 1e4 };
+        film.normal[i] = if i % 5 == 0 { [0.0; 3] } else { [next(), -0.0, -next()] };
     }
     film
 }
@@ -42,11 +34,7 @@ fn varied_film(seed: u32) -> Film {
 fn bits(film: &Film) -> Vec<u32> {
     let colors = film.color.iter().flatten();
     let normals = film.normal.iter().flatten();
-    colors
-        .chain(&film.depth)
-        .chain(normals)
-        .map(|v| v.to_bits())
-        .collect()
+    colors.chain(&film.depth).chain(normals).map(|v| v.to_bits()).collect()
 }
 
 fn all_options() -> OutputOptions {
@@ -83,21 +71,12 @@ fn exr_has_the_contract_channels_layout_and_compression() {
     assert_eq!(meta.headers.len(), 1, "one part");
     let header = &meta.headers[0];
     assert_eq!(header.compression, exr::compression::Compression::ZIP16);
-    assert_eq!(
-        header.line_order,
-        exr::meta::attribute::LineOrder::Increasing
-    );
+    assert_eq!(header.line_order, exr::meta::attribute::LineOrder::Increasing);
     assert_eq!(header.blocks, exr::meta::BlockDescription::ScanLines);
     assert_eq!(header.layer_size, exr::math::Vec2(37, 21));
     assert_eq!(header.own_attributes.layer_position, exr::math::Vec2(0, 0));
-    assert_eq!(
-        header.shared_attributes.display_window.size,
-        exr::math::Vec2(37, 21)
-    );
-    assert_eq!(
-        header.shared_attributes.display_window.position,
-        exr::math::Vec2(0, 0)
-    );
+    assert_eq!(header.shared_attributes.display_window.size, exr::math::Vec2(37, 21));
+    assert_eq!(header.shared_attributes.display_window.position, exr::math::Vec2(0, 0));
 
     let image = exr::prelude::read()
         .no_deep_data()
@@ -197,10 +176,7 @@ fn a_file_without_colour_is_an_error_naming_the_channel() {
 fn truncated_and_garbage_bytes_are_errors_not_panics() {
     let bytes = encode_exr(&varied_film(5)).expect("encode");
     for len in (0..bytes.len()).step_by(97).chain([bytes.len() - 1]) {
-        assert!(
-            decode_exr(&bytes[..len]).is_err(),
-            "truncated to {len} bytes decoded"
-        );
+        assert!(decode_exr(&bytes[..len]).is_err(), "truncated to {len} bytes decoded");
     }
     let mut state = 0x9e37_79b9_u32;
     let garbage: Vec<u8> = (0..4096)
@@ -239,10 +215,7 @@ fn write_exr_and_read_exr_round_trip_through_a_file() {
     let film = varied_film(6);
     write_exr(&path, &film).expect("write");
     assert_eq!(bits(&read_exr(&path).expect("read")), bits(&film));
-    assert_eq!(
-        dir_entries(&dir.path().join("nested/dir")),
-        names(&["a.exr"])
-    );
+    assert_eq!(dir_entries(&dir.path().join("nested/dir")), names(&["a.exr"]));
 }
 
 #[test]
@@ -251,29 +224,16 @@ fn write_outputs_writes_exactly_the_requested_files_in_order() {
     let out = dir.path().join("out");
     let film = varied_film(7);
     let written = write_outputs(&out, "scene", &film, &all_options()).expect("write");
-    let expected: Vec<PathBuf> = [
-        "scene.exr",
-        "scene.png",
-        "scene_depth.png",
-        "scene_normals.png",
-    ]
-    .iter()
-    .map(|name| out.join(name))
-    .collect();
+    let expected: Vec<PathBuf> = ["scene.exr", "scene.png", "scene_depth.png", "scene_normals.png"]
+        .iter()
+        .map(|name| out.join(name))
+        .collect();
     assert_eq!(written, expected);
     assert_eq!(
         dir_entries(&out),
-        names(&[
-            "scene.exr",
-            "scene.png",
-            "scene_depth.png",
-            "scene_normals.png"
-        ])
+        names(&["scene.exr", "scene.png", "scene_depth.png", "scene_normals.png"])
     );
-    assert_eq!(
-        fs::read(&expected[0]).expect("exr"),
-        encode_exr(&film).expect("encode")
-    );
+    assert_eq!(fs::read(&expected[0]).expect("exr"), encode_exr(&film).expect("encode"));
     let png = image::open(&expected[1]).expect("png").to_rgb8();
     assert_eq!(png, goldray::film::color_image(&film, Tonemap::Srgb));
 
@@ -293,10 +253,7 @@ fn write_outputs_replaces_existing_files() {
     let (old, new) = (varied_film(8), varied_film(9));
     write_outputs(dir.path(), "a", &old, &all_options()).expect("first");
     write_outputs(dir.path(), "a", &new, &all_options()).expect("second");
-    assert_eq!(
-        bits(&read_exr(&dir.path().join("a.exr")).expect("read")),
-        bits(&new)
-    );
+    assert_eq!(bits(&read_exr(&dir.path().join("a.exr")).expect("read")), bits(&new));
     assert_eq!(dir_entries(dir.path()).len(), 4, "no temp files left");
 }
 
@@ -309,13 +266,9 @@ fn a_failed_write_leaves_existing_outputs_untouched_and_no_temp_files() {
         write_outputs(dir.path(), "a", &varied_film(10), &all_options()).expect("first");
         fs::remove_file(dir.path().join(blocked)).expect("remove");
         fs::create_dir(dir.path().join(blocked)).expect("block");
-        let before: Vec<Option<Vec<u8>>> = all
-            .iter()
-            .map(|f| fs::read(dir.path().join(f)).ok())
-            .collect();
+        let before: Vec<Option<Vec<u8>>> = all.iter().map(|f| fs::read(dir.path().join(f)).ok()).collect();
 
-        let error = write_outputs(dir.path(), "a", &varied_film(11), &all_options())
-            .expect_err("blocked output");
+        let error = write_outputs(dir.path(), "a", &varied_film(11), &all_options()).expect_err("blocked output");
         assert!(matches!(error, OutputError::Write { .. }), "{error}");
         assert!(
             error
@@ -323,14 +276,8 @@ fn a_failed_write_leaves_existing_outputs_untouched_and_no_temp_files() {
                 .contains(&dir.path().join(blocked).display().to_string())
         );
 
-        let after: Vec<Option<Vec<u8>>> = all
-            .iter()
-            .map(|f| fs::read(dir.path().join(f)).ok())
-            .collect();
-        assert!(
-            before == after,
-            "outputs changed when {blocked} was blocked"
-        );
+        let after: Vec<Option<Vec<u8>>> = all.iter().map(|f| fs::read(dir.path().join(f)).ok()).collect();
+        assert!(before == after, "outputs changed when {blocked} was blocked");
         assert_eq!(
             dir_entries(dir.path()),
             names(&all),
@@ -344,8 +291,7 @@ fn an_unwritable_directory_is_an_error_naming_it() {
     let dir = tempfile::tempdir().expect("tempdir");
     let not_a_dir = dir.path().join("file");
     fs::write(&not_a_dir, b"keep").expect("file");
-    let error = write_outputs(&not_a_dir, "a", &varied_film(12), &all_options())
-        .expect_err("not a directory");
+    let error = write_outputs(&not_a_dir, "a", &varied_film(12), &all_options()).expect_err("not a directory");
     assert!(
         error
             .to_string()

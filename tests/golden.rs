@@ -42,16 +42,12 @@ fn diffs_dir() -> PathBuf {
 
 /// A path relative to the project root when it is inside it, so messages stay short.
 pub fn shown(path: &Path) -> String {
-    path.strip_prefix(ROOT)
-        .unwrap_or(path)
-        .display()
-        .to_string()
+    path.strip_prefix(ROOT).unwrap_or(path).display().to_string()
 }
 
 /// Sorted, so that failures are reported in the same order on every run.
 fn case_files() -> Vec<PathBuf> {
-    let entries = fs::read_dir(cases_dir())
-        .unwrap_or_else(|e| panic!("cannot list {}: {e}", shown(&cases_dir())));
+    let entries = fs::read_dir(cases_dir()).unwrap_or_else(|e| panic!("cannot list {}: {e}", shown(&cases_dir())));
     let mut files: Vec<PathBuf> = entries
         .filter_map(|entry| entry.ok().map(|e| e.path()))
         .filter(|path| path.extension().is_some_and(|ext| ext == "toml"))
@@ -72,20 +68,15 @@ fn render(path: &Path) -> Result<Rendered, String> {
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default();
-    if name.is_empty()
-        || !name
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
-    {
+    if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
         return Err(format!(
             "{}: a case name may only hold letters, digits, `_` and `-` (it names the snapshot file); rename the file",
             shown(path)
         ));
     }
-    let case = load(path, &LoadOptions::default())
-        .map_err(|e| explain_missing_shared(path, e.to_string(), &shared_dir()))?;
-    let film = render_case(&case, false)
-        .map_err(|e| explain_missing_shared(path, e.to_string(), &shared_dir()))?;
+    let case =
+        load(path, &LoadOptions::default()).map_err(|e| explain_missing_shared(path, e.to_string(), &shared_dir()))?;
+    let film = render_case(&case, false).map_err(|e| explain_missing_shared(path, e.to_string(), &shared_dir()))?;
     let exr = encode_exr(&film).map_err(|e| format!("{}: {e}", shown(path)))?;
     Ok(Rendered { case, film, exr })
 }
@@ -112,15 +103,10 @@ fn shared_dir() -> PathBuf {
 #[test]
 fn every_case_matches_its_golden_image() {
     let files = case_files();
-    assert!(
-        !files.is_empty(),
-        "no cases found in {}",
-        shown(&cases_dir())
-    );
+    assert!(!files.is_empty(), "no cases found in {}", shown(&cases_dir()));
     // Rendering is the slow part and needs no insta state, so it runs on every core; the
     // assertions then run one by one on this thread, where insta's settings are bound.
-    let rendered: Vec<Result<Rendered, String>> =
-        files.par_iter().map(|path| render(path)).collect();
+    let rendered: Vec<Result<Rendered, String>> = files.par_iter().map(|path| render(path)).collect();
     let mut failures: Vec<String> = rendered
         .into_iter()
         .filter_map(|result| result.and_then(|r| check(&r)).err())
@@ -160,20 +146,13 @@ fn check(rendered: &Rendered) -> Result<(), String> {
     let judged = judged.lock().map(|mut slot| slot.take()).unwrap_or(None);
     match (asserted, judged) {
         (Ok(()), Some(Judged::Compared(comparison))) if !comparison.verdict.accepts() => {
-            eprintln!(
-                "rewrote the golden of case {name} (INSTA_UPDATE); it differed by:\n{comparison}"
-            );
+            eprintln!("rewrote the golden of case {name} (INSTA_UPDATE); it differed by:\n{comparison}");
             Ok(())
         }
         (Ok(()), Some(Judged::Compared(comparison)))
-            if comparison
-                .metrics
-                .as_ref()
-                .is_some_and(|m| m.failing_pixels > 0) =>
+            if comparison.metrics.as_ref().is_some_and(|m| m.failing_pixels > 0) =>
         {
-            eprintln!(
-                "warning: case {name} is within tolerance but some pixels moved:\n{comparison}"
-            );
+            eprintln!("warning: case {name} is within tolerance but some pixels moved:\n{comparison}");
             Ok(())
         }
         (Ok(()), _) => Ok(()),
@@ -193,8 +172,7 @@ fn failure_message(case: &Case, golden: &Path, judged: Option<Judged>) -> String
     let case_file = shown(&case.path);
     let preview = shown(&actual_png);
     let pending = if is_ci() {
-        "CI=true, so nothing was written: run the suite locally to get a pending snapshot"
-            .to_owned()
+        "CI=true, so nothing was written: run the suite locally to get a pending snapshot".to_owned()
     } else {
         format!("pending as {}.new", shown(golden))
     };
@@ -207,9 +185,9 @@ fn failure_message(case: &Case, golden: &Path, judged: Option<Judged>) -> String
              then commit golden/{name}.snap and golden/{name}.snap.exr",
             shown(golden)
         ),
-        Some(Judged::Unreadable(message)) => format!(
-            "case {name} ({case_file}): {message}\n  if the new render ({preview}) is right, {accept}"
-        ),
+        Some(Judged::Unreadable(message)) => {
+            format!("case {name} ({case_file}): {message}\n  if the new render ({preview}) is right, {accept}")
+        }
         Some(Judged::Compared(comparison)) => {
             format!(
                 "case {name} ({case_file}): {comparison}  if the change is intended, compare {preview} with its \
@@ -229,10 +207,9 @@ fn orphan_goldens(case_files: &[PathBuf]) -> Vec<String> {
         .filter(|path| path.extension().is_some_and(|ext| ext == "snap"))
         .filter_map(|path| {
             let stem = path.file_stem()?.to_string_lossy().into_owned();
-            let has_case = case_files.iter().any(|case| {
-                case.file_stem()
-                    .is_some_and(|s| s.to_string_lossy() == stem)
-            });
+            let has_case = case_files
+                .iter()
+                .any(|case| case.file_stem().is_some_and(|s| s.to_string_lossy() == stem));
             (!has_case).then(|| {
                 format!(
                     "{} has no case cases/{stem}.toml: delete it and {}.exr, or restore the case",
@@ -248,10 +225,7 @@ fn orphan_goldens(case_files: &[PathBuf]) -> Vec<String> {
 
 /// insta's own reading of `CI`, so the message matches what insta did.
 fn is_ci() -> bool {
-    !matches!(
-        std::env::var("CI").as_deref(),
-        Err(_) | Ok("" | "0" | "false")
-    )
+    !matches!(std::env::var("CI").as_deref(), Err(_) | Ok("" | "0" | "false"))
 }
 
 #[test]
@@ -263,8 +237,7 @@ fn a_case_that_needs_the_missing_shared_directory_says_so() {
         "[[object]]\nkind = \"mesh\"\nobj = \"../../shared/mit6837/bunny.obj\"\n",
     )
     .expect("written");
-    let message =
-        explain_missing_shared(&case, "no such file".to_owned(), &dir.path().join("shared"));
+    let message = explain_missing_shared(&case, "no such file".to_owned(), &dir.path().join("shared"));
     assert!(
         message.starts_with("no such file\n") && message.contains("is missing"),
         "{message}"

@@ -11,7 +11,9 @@ use goldray::options::Precision;
 use goldray::pipeline::render_case;
 
 fn case(name: &str, precision: Precision) -> Case {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases").join(format!("{name}.toml"));
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("cases")
+        .join(format!("{name}.toml"));
     let mut case = load(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
     case.render.precision = precision;
     case
@@ -44,13 +46,26 @@ fn picture(mut film: Film) -> Film {
 /// against their `f32` render, and yet the films differ (the key is not ignored).
 #[test]
 fn f64_draws_the_f32_picture_with_different_arithmetic() {
-    for name in ["spheres_shadows", "mirrors", "transforms", "vertex_normals", "jitter_filter"] {
+    for name in [
+        "spheres_shadows",
+        "mirrors",
+        "transforms",
+        "vertex_normals",
+        "jitter_filter",
+    ] {
         let single = picture(render_with_threads(&case(name, Precision::F32), 2));
         let double = picture(render_with_threads(&case(name, Precision::F64), 2));
         let tolerance = case(name, Precision::F32).tolerance;
-        let comparison = compare(&Image::from_film(&single, "f32.exr"), &Image::from_film(&double, "f64.exr"), &tolerance);
+        let comparison = compare(
+            &Image::from_film(&single, "f32.exr"),
+            &Image::from_film(&double, "f64.exr"),
+            &tolerance,
+        );
         assert_eq!(comparison.verdict, Verdict::Pass, "{name}:\n{comparison}");
-        assert!(single.color != double.color, "{name}: the f64 render is bit-identical to f32");
+        assert!(
+            single.color != double.color,
+            "{name}: the f64 render is bit-identical to f32"
+        );
     }
 }
 
@@ -60,19 +75,30 @@ fn precision_survives_the_case_file_round_trip_and_defaults_to_f32() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/mirrors.toml");
     let toml = case_to_toml(&case, &path);
     assert!(toml.contains("precision = \"f64\""), "{toml}");
-    assert_eq!(parse(&toml, &path, &LoadOptions::default()).unwrap().render.precision, Precision::F64);
+    assert_eq!(
+        parse(&toml, &path, &LoadOptions::default()).unwrap().render.precision,
+        Precision::F64
+    );
     case.render.precision = Precision::F32;
     let toml = case_to_toml(&case, &path);
     assert!(!toml.contains("precision"), "the default is not written: {toml}");
-    assert_eq!(parse(&toml, &path, &LoadOptions::default()).unwrap().render.precision, Precision::F32);
+    assert_eq!(
+        parse(&toml, &path, &LoadOptions::default()).unwrap().render.precision,
+        Precision::F32
+    );
 }
 
 #[test]
 fn an_unknown_precision_is_an_error_listing_the_valid_ones() {
     let toml = "[render]\nprecision = \"f16\"\n[camera]\ncenter = [0, 0, 10]\ndirection = [0, 0, -1]\nup = [0, 1, 0]\nfov = 30\n";
-    let error = parse(toml, Path::new("p.toml"), &LoadOptions::default()).unwrap_err().to_string();
+    let error = parse(toml, Path::new("p.toml"), &LoadOptions::default())
+        .unwrap_err()
+        .to_string();
     assert!(error.contains("p.toml:2:13"), "{error}");
-    assert!(error.contains("f16") && error.contains("f32") && error.contains("f64"), "{error}");
+    assert!(
+        error.contains("f16") && error.contains("f32") && error.contains("f64"),
+        "{error}"
+    );
 }
 
 /// Far from the origin, a mesh file's own coordinates keep their digits only in `f64`: the
@@ -99,7 +125,19 @@ fn f64_keeps_the_digits_of_a_mesh_file_far_from_the_origin() {
     let double = render_with_threads(&case, 2);
     case.render.precision = Precision::F32;
     let single = render_with_threads(&case, 2);
-    let tolerance = Tolerance { pixel: 0.01, fail_fraction: 0.0, rmse: 1.0, max: None };
-    let comparison = compare(&Image::from_film(&double, "f64.exr"), &Image::from_film(&single, "f32.exr"), &tolerance);
-    assert!(matches!(comparison.verdict, Verdict::Fail { .. }), "f32 should lose the mesh's digits at 1e5:\n{comparison}");
+    let tolerance = Tolerance {
+        pixel: 0.01,
+        fail_fraction: 0.0,
+        rmse: 1.0,
+        max: None,
+    };
+    let comparison = compare(
+        &Image::from_film(&double, "f64.exr"),
+        &Image::from_film(&single, "f32.exr"),
+        &tolerance,
+    );
+    assert!(
+        matches!(comparison.verdict, Verdict::Fail { .. }),
+        "f32 should lose the mesh's digits at 1e5:\n{comparison}"
+    );
 }

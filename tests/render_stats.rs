@@ -13,8 +13,8 @@ use goldray::film::Film;
 use goldray::pipeline::render_options;
 use goldray::progress::Progress;
 use goldray::render::{render, render_counting_rays};
-use goldray::stats::RayCounts;
 use goldray::scene::build_scene;
+use goldray::stats::RayCounts;
 
 const CAMERA: &str = "[camera]\ncenter = [0, 0, 10]\ndirection = [0, 0, -1]\nup = [0, 1, 0]\nfov = 30\n";
 
@@ -40,7 +40,12 @@ fn counted(case: &Case) -> (Film, RayCounts) {
 }
 
 fn rays(camera: u64, aov: u64, shadow: u64, reflection: u64) -> RayCounts {
-    RayCounts { camera, aov, shadow, reflection }
+    RayCounts {
+        camera,
+        aov,
+        shadow,
+        reflection,
+    }
 }
 
 fn hits(film: &Film) -> u64 {
@@ -71,7 +76,10 @@ fn the_gaussian_filter_traces_nine_subpixels_per_pixel() {
 fn shadow_rays_are_one_per_light_per_hit() {
     let (film, counts) = counted(&case("shadows = true", &format!("{TWO_POINT_LIGHTS}{SPHERE}")));
     let hits = hits(&film);
-    assert!(hits > 0 && hits < 100, "the sphere covers part of the frame: {hits} hits");
+    assert!(
+        hits > 0 && hits < 100,
+        "the sphere covers part of the frame: {hits} hits"
+    );
     assert_eq!(counts, rays(100, 0, 2 * hits, 0));
     let (_, unshadowed) = counted(&case("", &format!("{TWO_POINT_LIGHTS}{SPHERE}")));
     assert_eq!(unshadowed, rays(100, 0, 0, 0), "no shadow rays without `shadows`");
@@ -114,7 +122,10 @@ fn busy_case() -> Case {
          [[object]]\nkind = \"sphere\"\ncenter = [0.7, 0.2, -1]\nradius = 0.8\nmaterial = \"chrome\"\n\
          [[object]]\nkind = \"plane\"\nnormal = [0, 1, 0]\noffset = -1\nmaterial = \"chrome\"\n"
     );
-    sized_case("size = [37, 23]\nsamples = 4\nbounces = 3\nshadows = true\nfilter = \"gaussian\"", &body)
+    sized_case(
+        "size = [37, 23]\nsamples = 4\nbounces = 3\nshadows = true\nfilter = \"gaussian\"",
+        &body,
+    )
 }
 
 #[test]

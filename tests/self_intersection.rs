@@ -14,7 +14,12 @@ use proptest::test_runner::{Config, RngSeed};
 const SPAWNED_PER_HIT: usize = 1000;
 
 fn config() -> Config {
-    Config { cases: 96, rng_seed: RngSeed::Fixed(0x0601_d4a7), failure_persistence: None, ..Config::default() }
+    Config {
+        cases: 96,
+        rng_seed: RngSeed::Fixed(0x0601_d4a7),
+        failure_persistence: None,
+        ..Config::default()
+    }
 }
 
 /// Magnitudes spread evenly over sixteen decades, either sign.
@@ -39,14 +44,28 @@ fn unit_vector() -> impl Strategy<Value = Vec3> {
 /// Random non-degenerate affine transforms: per-axis scales over eight decades, a rotation,
 /// and a translation over sixteen.
 fn transform() -> impl Strategy<Value = Transform> {
-    (point(), unit_vector(), 0.0f32..std::f32::consts::TAU, -4.0f64..4.0, -1.0f64..1.0, -1.0f64..1.0).prop_map(
-        |(translation, axis, angle, scale, squash_y, squash_z)| {
-            let s = 10f64.powf(scale);
-            let scales = Vec3::new(s as Real, (s * 10f64.powf(squash_y)) as Real, (s * 10f64.powf(squash_z)) as Real);
-            Transform::new(Mat4::from_scale_rotation_translation(scales, glam::Quat::from_axis_angle(axis, angle), translation))
-                .expect("scales within eight decades are not singular")
-        },
+    (
+        point(),
+        unit_vector(),
+        0.0f32..std::f32::consts::TAU,
+        -4.0f64..4.0,
+        -1.0f64..1.0,
+        -1.0f64..1.0,
     )
+        .prop_map(|(translation, axis, angle, scale, squash_y, squash_z)| {
+            let s = 10f64.powf(scale);
+            let scales = Vec3::new(
+                s as Real,
+                (s * 10f64.powf(squash_y)) as Real,
+                (s * 10f64.powf(squash_z)) as Real,
+            );
+            Transform::new(Mat4::from_scale_rotation_translation(
+                scales,
+                glam::Quat::from_axis_angle(axis, angle),
+                translation,
+            ))
+            .expect("scales within eight decades are not singular")
+        })
 }
 
 /// `count` directions from a fixed sequence, turned into the hemisphere around `normal`.

@@ -12,8 +12,8 @@ use std::time::Duration;
 use goldray::case::{Case, LoadOptions, parse};
 use goldray::options::{Filter, Precision};
 use goldray::tradeoff::{
-    CSV_COLUMNS, CSV_FILE, MARKDOWN_FILE, Metric, PLOT_FILE, PLOT_HEIGHT, PLOT_WIDTH, SweepPlan, Tradeoff, TradeoffOptions,
-    measure_tradeoff, pareto_front, run_tradeoff,
+    CSV_COLUMNS, CSV_FILE, MARKDOWN_FILE, Metric, PLOT_FILE, PLOT_HEIGHT, PLOT_WIDTH, SweepPlan, Tradeoff,
+    TradeoffOptions, measure_tradeoff, pareto_front, run_tradeoff,
 };
 
 fn case(toml: &str) -> Case {
@@ -32,7 +32,10 @@ fn plan(samples: &[u32], reference_samples: u32) -> SweepPlan {
 }
 
 fn measure(case: &Case, plan: SweepPlan) -> Tradeoff {
-    let options = TradeoffOptions { plan, ..TradeoffOptions::new("unused") };
+    let options = TradeoffOptions {
+        plan,
+        ..TradeoffOptions::new("unused")
+    };
     measure_tradeoff(case, &options).unwrap_or_else(|e| panic!("{e}"))
 }
 
@@ -79,12 +82,29 @@ fn error_falls_with_samples_faster_than_one_over_root_n_on_edges() {
     let t = measure(&case(EDGES), plan(&samples, 2304));
     let rmse: Vec<f64> = samples
         .iter()
-        .map(|&n| t.measurements.iter().find(|m| m.in_grid && m.setting.samples == n).unwrap().errors.rmse)
+        .map(|&n| {
+            t.measurements
+                .iter()
+                .find(|m| m.in_grid && m.setting.samples == n)
+                .unwrap()
+                .errors
+                .rmse
+        })
         .collect();
-    assert!(rmse.windows(2).all(|w| w[1] < w[0]), "RMSE falls with every step: {rmse:?}");
+    assert!(
+        rmse.windows(2).all(|w| w[1] < w[0]),
+        "RMSE falls with every step: {rmse:?}"
+    );
     let flips: Vec<f64> = samples
         .iter()
-        .map(|&n| t.measurements.iter().find(|m| m.in_grid && m.setting.samples == n).unwrap().errors.flip)
+        .map(|&n| {
+            t.measurements
+                .iter()
+                .find(|m| m.in_grid && m.setting.samples == n)
+                .unwrap()
+                .errors
+                .flip
+        })
         .collect();
     assert!(flips[3] < flips[0], "FLIP falls too: {flips:?}");
     // Least-squares slope of ln(RMSE) against ln(samples). Independent random samples give −½;
@@ -94,7 +114,10 @@ fn error_falls_with_samples_faster_than_one_over_root_n_on_edges() {
     let (mx, my) = (xs.iter().sum::<f64>() / 4.0, ys.iter().sum::<f64>() / 4.0);
     let slope = xs.iter().zip(&ys).map(|(x, y)| (x - mx) * (y - my)).sum::<f64>()
         / xs.iter().map(|x| (x - mx).powi(2)).sum::<f64>();
-    assert!(slope < -0.6, "stratified jitter converges faster than 1/√n on edges: slope {slope:.3}, RMSE {rmse:?}");
+    assert!(
+        slope < -0.6,
+        "stratified jitter converges faster than 1/√n on edges: slope {slope:.3}, RMSE {rmse:?}"
+    );
 }
 
 /// A camera between two parallel mirrors: every ray bounces between them forever, each bounce
@@ -139,23 +162,54 @@ material = "mirror"
 #[test]
 fn reflections_converge_with_bounces_and_the_bounce_sweep_stops() {
     let cap = 30;
-    let t = measure(&case(MIRRORS), SweepPlan { max_bounces: cap, ..plan(&[1], 4) });
+    let t = measure(
+        &case(MIRRORS),
+        SweepPlan {
+            max_bounces: cap,
+            ..plan(&[1], 4)
+        },
+    );
     let mut sweep: Vec<_> = t.measurements.iter().filter(|m| m.in_bounce_sweep).collect();
     sweep.sort_by_key(|m| m.setting.bounces);
     let bounces: Vec<u32> = sweep.iter().map(|m| m.setting.bounces).collect();
-    assert_eq!(bounces, (0..=t.bounces.last).collect::<Vec<_>>(), "every depth from 0, once");
+    assert_eq!(
+        bounces,
+        (0..=t.bounces.last).collect::<Vec<_>>(),
+        "every depth from 0, once"
+    );
     assert!(t.bounces.settled, "the picture settles: {:?}", t.bounces);
-    assert!(t.bounces.last < cap && t.bounces.last >= 5, "a geometric series of ½ needs several bounces: {:?}", t.bounces);
+    assert!(
+        t.bounces.last < cap && t.bounces.last >= 5,
+        "a geometric series of ½ needs several bounces: {:?}",
+        t.bounces
+    );
     assert!(t.bounces.last_change <= t.bounces.threshold);
     let rmse: Vec<f64> = sweep.iter().map(|m| m.errors.rmse).collect();
     let max: Vec<f64> = sweep.iter().map(|m| m.errors.max).collect();
-    assert!(rmse.windows(2).all(|w| w[1] <= w[0]), "RMSE never grows with depth: {rmse:?}");
+    assert!(
+        rmse.windows(2).all(|w| w[1] <= w[0]),
+        "RMSE never grows with depth: {rmse:?}"
+    );
     assert!(max.windows(2).all(|w| w[1] <= w[0]), "nor the largest error: {max:?}");
-    assert!(rmse[0] > 10.0 * rmse[rmse.len() - 1], "deep enough is much better than none: {rmse:?}");
-    assert_eq!(t.reference.bounces, t.bounces.last, "the reference is as deep as the sweep went");
-    assert!(t.measurements.iter().filter(|m| m.in_grid).all(|m| m.setting.bounces == t.bounces.enough()));
+    assert!(
+        rmse[0] > 10.0 * rmse[rmse.len() - 1],
+        "deep enough is much better than none: {rmse:?}"
+    );
+    assert_eq!(
+        t.reference.bounces, t.bounces.last,
+        "the reference is as deep as the sweep went"
+    );
+    assert!(
+        t.measurements
+            .iter()
+            .filter(|m| m.in_grid)
+            .all(|m| m.setting.bounces == t.bounces.enough())
+    );
     let reflections: Vec<u64> = sweep.iter().map(|m| m.rays.reflection).collect();
-    assert!(reflections.windows(2).all(|w| w[1] > w[0]), "each bounce traces more reflection rays: {reflections:?}");
+    assert!(
+        reflections.windows(2).all(|w| w[1] > w[0]),
+        "each bounce traces more reflection rays: {reflections:?}"
+    );
 }
 
 /// A plane filling the whole view under one light: every sample hits it and casts one shadow ray.
@@ -230,7 +284,10 @@ fn the_report_reads_back_with_every_setting_and_the_plot_decodes() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("report");
     let (t, written) = run_tradeoff(&shipped("mirrors.toml"), &tiny_options(&out)).unwrap_or_else(|e| panic!("{e}"));
-    assert_eq!(written, [out.join(CSV_FILE), out.join(MARKDOWN_FILE), out.join(PLOT_FILE)]);
+    assert_eq!(
+        written,
+        [out.join(CSV_FILE), out.join(MARKDOWN_FILE), out.join(PLOT_FILE)]
+    );
 
     let csv = fs::read_to_string(out.join(CSV_FILE)).unwrap();
     let mut lines = csv.lines();
@@ -238,7 +295,11 @@ fn the_report_reads_back_with_every_setting_and_the_plot_decodes() {
     let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
     assert_eq!(rows.len(), t.measurements.len());
     let column = |name: &str| CSV_COLUMNS.iter().position(|c| *c == name).unwrap();
-    let number = |row: &[&str], name: &str| row[column(name)].parse::<f64>().unwrap_or_else(|e| panic!("{name}: {e}"));
+    let number = |row: &[&str], name: &str| {
+        row[column(name)]
+            .parse::<f64>()
+            .unwrap_or_else(|e| panic!("{name}: {e}"))
+    };
     let mut points = Vec::new();
     for (row, m) in rows.iter().zip(&t.measurements) {
         assert_eq!(row.len(), CSV_COLUMNS.len(), "{row:?}");
@@ -251,20 +312,33 @@ fn the_report_reads_back_with_every_setting_and_the_plot_decodes() {
         points.push((number(row, "seconds"), number(row, "flip")));
     }
     let front: Vec<bool> = rows.iter().map(|r| r[column("pareto")].parse().unwrap()).collect();
-    assert_eq!(front, pareto_front(&points), "the pareto column is the front of the CSV's own numbers by --metric");
+    assert_eq!(
+        front,
+        pareto_front(&points),
+        "the pareto column is the front of the CSV's own numbers by --metric"
+    );
     let expected_grid = 4; // samples 1, 4 × filters none, gaussian
-    assert_eq!(rows.iter().filter(|r| r[column("sweep")].starts_with("grid")).count(), expected_grid);
+    assert_eq!(
+        rows.iter().filter(|r| r[column("sweep")].starts_with("grid")).count(),
+        expected_grid
+    );
 
     let markdown = fs::read_to_string(out.join(MARKDOWN_FILE)).unwrap();
     assert!(markdown.contains("# Speed and accuracy: mirrors"), "{markdown}");
     assert!(markdown.contains(&t.measurements[0].setting.label()));
-    assert!(markdown.contains("**Target:**") && markdown.contains("FLIP mean ≤ 0.5"), "{markdown}");
+    assert!(
+        markdown.contains("**Target:**") && markdown.contains("FLIP mean ≤ 0.5"),
+        "{markdown}"
+    );
     assert!(markdown.contains("](tradeoff.png)"));
 
     let plot = image::open(out.join(PLOT_FILE)).unwrap();
     assert_eq!((plot.width(), plot.height()), (PLOT_WIDTH, PLOT_HEIGHT));
     let colours: std::collections::HashSet<_> = plot.to_rgb8().pixels().map(|p| p.0).collect();
-    assert!(colours.len() > 20, "the plot has curves, text and a legend, not a blank page");
+    assert!(
+        colours.len() > 20,
+        "the plot has curves, text and a legend, not a blank page"
+    );
 
     // A second run replaces its own report; a file goldray did not write is refused untouched.
     run_tradeoff(&shipped("mirrors.toml"), &tiny_options(&out)).unwrap_or_else(|e| panic!("{e}"));
@@ -272,14 +346,28 @@ fn the_report_reads_back_with_every_setting_and_the_plot_decodes() {
     let refused = run_tradeoff(&shipped("mirrors.toml"), &tiny_options(&out)).unwrap_err();
     assert!(refused.to_string().contains("--force"), "{refused}");
     assert_eq!(fs::read_to_string(out.join(MARKDOWN_FILE)).unwrap(), "# my notes\n");
-    run_tradeoff(&shipped("mirrors.toml"), &TradeoffOptions { force: true, ..tiny_options(&out) }).unwrap();
-    assert!(fs::read_to_string(out.join(MARKDOWN_FILE)).unwrap().contains("Speed and accuracy"));
+    run_tradeoff(
+        &shipped("mirrors.toml"),
+        &TradeoffOptions {
+            force: true,
+            ..tiny_options(&out)
+        },
+    )
+    .unwrap();
+    assert!(
+        fs::read_to_string(out.join(MARKDOWN_FILE))
+            .unwrap()
+            .contains("Speed and accuracy")
+    );
 }
 
 #[test]
 fn the_target_is_the_fastest_setting_that_meets_it_or_a_clear_no() {
     let options = |target| TradeoffOptions {
-        plan: SweepPlan { size: Some((16, 16)), ..plan(&[1, 4, 16], 64) },
+        plan: SweepPlan {
+            size: Some((16, 16)),
+            ..plan(&[1, 4, 16], 64)
+        },
         target_flip: Some(target),
         ..TradeoffOptions::new("unused")
     };
@@ -294,7 +382,10 @@ fn the_target_is_the_fastest_setting_that_meets_it_or_a_clear_no() {
 }
 
 fn goldray(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_goldray")).args(args).output().expect("the goldray binary runs")
+    Command::new(env!("CARGO_BIN_EXE_goldray"))
+        .args(args)
+        .output()
+        .expect("the goldray binary runs")
 }
 
 fn stderr(output: &Output) -> String {
@@ -302,7 +393,17 @@ fn stderr(output: &Output) -> String {
 }
 
 const QUICK: [&str; 12] = [
-    "--size", "24x20", "--samples", "1,4", "--reference-samples", "16", "--max-bounces", "3", "--min-time", "0", "--quiet",
+    "--size",
+    "24x20",
+    "--samples",
+    "1,4",
+    "--reference-samples",
+    "16",
+    "--max-bounces",
+    "3",
+    "--min-time",
+    "0",
+    "--quiet",
     "--force",
 ];
 
@@ -324,7 +425,14 @@ fn the_command_runs_on_every_shipped_case() {
             let name = path.file_stem().unwrap().to_string_lossy().into_owned();
             let out = dir.path().join(&name);
             let child = Command::new(env!("CARGO_BIN_EXE_goldray"))
-                .args(["tradeoff", path.to_str().unwrap(), "--out", out.to_str().unwrap(), "--target-flip", "0.1"])
+                .args([
+                    "tradeoff",
+                    path.to_str().unwrap(),
+                    "--out",
+                    out.to_str().unwrap(),
+                    "--target-flip",
+                    "0.1",
+                ])
                 .args(QUICK)
                 .args(["--threads", "1"])
                 .stdout(std::process::Stdio::piped())
@@ -338,7 +446,10 @@ fn the_command_runs_on_every_shipped_case() {
         let result = child.wait_with_output().unwrap();
         assert!(result.status.success(), "{name}: {}", stderr(&result));
         let stdout = String::from_utf8_lossy(&result.stdout);
-        assert!(stdout.starts_with("target: "), "{name}: --quiet still answers the target: {stdout}");
+        assert!(
+            stdout.starts_with("target: "),
+            "{name}: --quiet still answers the target: {stdout}"
+        );
         for file in [CSV_FILE, MARKDOWN_FILE, PLOT_FILE] {
             assert!(out.join(file).is_file(), "{name}: {file}");
         }
@@ -356,15 +467,56 @@ fn bad_input_is_a_clear_error_and_writes_nothing() {
     let jitter = jitter.to_str().unwrap();
     let out_arg = out.to_str().unwrap();
     let cases: [(&[&str], i32, &str); 9] = [
-        (&["tradeoff", "no/such/case.toml", "--out", out_arg], 1, "no/such/case.toml"),
-        (&["tradeoff", jitter, "--out", out_arg, "--samples", "1,3"], 2, "perfect square"),
-        (&["tradeoff", jitter, "--out", out_arg, "--size", "24"], 2, "WIDTHxHEIGHT"),
-        (&["tradeoff", jitter, "--out", out_arg, "--target-flip", "2"], 2, "from 0 to 1"),
-        (&["tradeoff", jitter, "--out", out_arg, "--filters", "box"], 2, "none or gaussian"),
-        (&["tradeoff", jitter, "--out", out_arg, "--precisions", "f16"], 2, "f32 or f64"),
+        (
+            &["tradeoff", "no/such/case.toml", "--out", out_arg],
+            1,
+            "no/such/case.toml",
+        ),
+        (
+            &["tradeoff", jitter, "--out", out_arg, "--samples", "1,3"],
+            2,
+            "perfect square",
+        ),
+        (
+            &["tradeoff", jitter, "--out", out_arg, "--size", "24"],
+            2,
+            "WIDTHxHEIGHT",
+        ),
+        (
+            &["tradeoff", jitter, "--out", out_arg, "--target-flip", "2"],
+            2,
+            "from 0 to 1",
+        ),
+        (
+            &["tradeoff", jitter, "--out", out_arg, "--filters", "box"],
+            2,
+            "none or gaussian",
+        ),
+        (
+            &["tradeoff", jitter, "--out", out_arg, "--precisions", "f16"],
+            2,
+            "f32 or f64",
+        ),
         (&["tradeoff", jitter, "--out", out_arg, "--threads", "0"], 2, "threads"),
-        (&["tradeoff", jitter, "--out", out_arg, "--max-bounces", "2000"], 2, "max-bounces"),
-        (&["tradeoff", jitter, "--out", out_arg, "--samples", "1,64", "--reference-samples", "64"], 1, "more samples than every setting"),
+        (
+            &["tradeoff", jitter, "--out", out_arg, "--max-bounces", "2000"],
+            2,
+            "max-bounces",
+        ),
+        (
+            &[
+                "tradeoff",
+                jitter,
+                "--out",
+                out_arg,
+                "--samples",
+                "1,64",
+                "--reference-samples",
+                "64",
+            ],
+            1,
+            "more samples than every setting",
+        ),
     ];
     for (args, code, message) in cases {
         let result = goldray(args);
@@ -379,7 +531,11 @@ fn bad_input_is_a_clear_error_and_writes_nothing() {
     args.extend(&QUICK[..QUICK.len() - 1]); // everything but --force
     let refused = goldray(&args);
     assert_eq!(refused.status.code(), Some(1));
-    assert!(stderr(&refused).contains("not written by goldray tradeoff; pass --force"), "{}", stderr(&refused));
+    assert!(
+        stderr(&refused).contains("not written by goldray tradeoff; pass --force"),
+        "{}",
+        stderr(&refused)
+    );
     assert_eq!(fs::read_to_string(out.join(CSV_FILE)).unwrap(), "name,score\nada,10\n");
     assert_eq!(fs::read_dir(&out).unwrap().count(), 1, "nothing else written");
 }

@@ -6,13 +6,15 @@
 use std::path::Path;
 
 use goldray::case::{LoadOptions, parse};
-use goldray::pipeline::render_case;
 use goldray::options::Precision;
+use goldray::pipeline::render_case;
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else { return };
-    let Ok(mut case) = parse(text, Path::new("fuzz/case.toml"), &LoadOptions::default()) else { return };
+    let Ok(mut case) = parse(text, Path::new("fuzz/case.toml"), &LoadOptions::default()) else {
+        return;
+    };
     let settings = &mut case.render;
     settings.width = settings.width.min(4);
     settings.height = settings.height.min(4);
@@ -21,7 +23,10 @@ fuzz_target!(|data: &[u8]| {
     for precision in Precision::ALL {
         case.render.precision = precision;
         if let Ok(film) = render_case(&case, false) {
-            assert!(film.color.iter().flatten().all(|c| c.is_finite()), "a non-finite colour reached the film");
+            assert!(
+                film.color.iter().flatten().all(|c| c.is_finite()),
+                "a non-finite colour reached the film"
+            );
         }
     }
 });

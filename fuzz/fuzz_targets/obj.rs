@@ -10,10 +10,16 @@ use libfuzzer_sys::fuzz_target;
 fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else { return };
     let path = Path::new("fuzz/mesh.obj");
-    for normals in [single::geometry::mesh::NormalSource::FromFileOrAveraged, single::geometry::mesh::NormalSource::Averaged] {
+    for normals in [
+        single::geometry::mesh::NormalSource::FromFileOrAveraged,
+        single::geometry::mesh::NormalSource::Averaged,
+    ] {
         let _ = single::geometry::mesh::Mesh::from_obj_text(text, path, normals);
     }
-    for normals in [double::geometry::mesh::NormalSource::FromFileOrAveraged, double::geometry::mesh::NormalSource::Averaged] {
+    for normals in [
+        double::geometry::mesh::NormalSource::FromFileOrAveraged,
+        double::geometry::mesh::NormalSource::Averaged,
+    ] {
         let _ = double::geometry::mesh::Mesh::from_obj_text(text, path, normals);
     }
 });

@@ -15,11 +15,11 @@ use std::path::Path;
 
 use lexer::{Lexer, Result, Token, Vec3, quote};
 
+use super::RenderSettings;
 use super::error::{CaseError, suggest};
 use super::sections::MAX_BOUNCES;
 use super::spec::{BackgroundSpec, Case, MaterialSpec};
 use super::value::has_usable_length;
-use super::RenderSettings;
 use crate::film::Tonemap;
 use crate::options::{Filter, Precision, Profile};
 
@@ -55,13 +55,7 @@ impl Default for AssignmentOptions {
     }
 }
 
-const BLOCKS: &[&str] = &[
-    "PerspectiveCamera",
-    "Background",
-    "Lights",
-    "Materials",
-    "Group",
-];
+const BLOCKS: &[&str] = &["PerspectiveCamera", "Background", "Lights", "Materials", "Group"];
 
 /// The course sets this when the scene has no lights, so that unlit scenes show their colours.
 const AMBIENT_WITHOUT_LIGHTS: [f64; 3] = [1.0; 3];
@@ -75,11 +69,7 @@ pub fn load_assignment_scene(path: &Path, options: &AssignmentOptions) -> Result
 }
 
 /// `path` is not read: it names the scene in messages and anchors its relative asset paths.
-pub fn parse_assignment_scene(
-    source: &str,
-    path: &Path,
-    options: &AssignmentOptions,
-) -> Result<Case> {
+pub fn parse_assignment_scene(source: &str, path: &Path, options: &AssignmentOptions) -> Result<Case> {
     let render = render_settings(path, options)?;
     let dir = path.parent().unwrap_or(Path::new(""));
     let mut parser = Parser {
@@ -114,12 +104,10 @@ pub fn parse_assignment_scene(
         file: path.to_path_buf(),
         message: message.to_owned(),
     };
-    let camera = camera.ok_or_else(|| {
-        missing("the scene has no PerspectiveCamera { center … direction … up … angle … } block")
-    })?;
-    let objects = objects.ok_or_else(|| {
-        missing("the scene has no top-level Group { numObjects N … } block, so nothing to render")
-    })?;
+    let camera = camera
+        .ok_or_else(|| missing("the scene has no PerspectiveCamera { center … direction … up … angle … } block"))?;
+    let objects = objects
+        .ok_or_else(|| missing("the scene has no top-level Group { numObjects N … } block, so nothing to render"))?;
     if lights.is_empty() {
         background.ambient = AMBIENT_WITHOUT_LIGHTS;
     }
@@ -150,22 +138,16 @@ fn render_settings(path: &Path, o: &AssignmentOptions) -> Result<RenderSettings>
     };
     if o.width == 0 || o.height == 0 {
         let (w, h) = (o.width, o.height);
-        return Err(invalid(format!(
-            "-size {w} {h}: the image needs at least one pixel"
-        )));
+        return Err(invalid(format!("-size {w} {h}: the image needs at least one pixel")));
     }
     if i64::from(o.bounces) > MAX_BOUNCES {
         let n = o.bounces;
-        return Err(invalid(format!(
-            "-bounces {n}: at most {MAX_BOUNCES} are allowed"
-        )));
+        return Err(invalid(format!("-bounces {n}: at most {MAX_BOUNCES} are allowed")));
     }
     if let Some((min, max)) = o.depth_range
         && !(min.is_finite() && max.is_finite() && min < max)
     {
-        return Err(invalid(format!(
-            "-depth {min} {max}: needs finite min < max"
-        )));
+        return Err(invalid(format!("-depth {min} {max}: needs finite min < max")));
     }
     Ok(RenderSettings {
         width: o.width,
@@ -174,11 +156,7 @@ fn render_settings(path: &Path, o: &AssignmentOptions) -> Result<RenderSettings>
         shadows: o.shadows,
         samples: if o.jitter { 16 } else { 1 },
         seed: 0,
-        filter: if o.filter {
-            Filter::Gaussian
-        } else {
-            Filter::None
-        },
+        filter: if o.filter { Filter::Gaussian } else { Filter::None },
         depth_range: o.depth_range,
         normals: o.normals,
         tonemap: Tonemap::Clamp,
@@ -235,10 +213,8 @@ impl<'a> Parser<'a> {
     fn invalid_vec(&self, v: &Vec3, subject: &str, rule: &str) -> CaseError {
         let written = self.lex.span_text(v.tokens[0], v.tokens[2]);
         let found = quote(&written.split_whitespace().collect::<Vec<_>>().join(" "));
-        self.lex.error_at(
-            v.tokens[0].start,
-            format!("{subject} {rule}, found {found}"),
-        )
+        self.lex
+            .error_at(v.tokens[0].start, format!("{subject} {rule}, found {found}"))
     }
 
     /// "unknown WHAT `word`", with the nearest of `valid` suggested and all of them listed as
@@ -246,25 +222,13 @@ impl<'a> Parser<'a> {
     fn unknown(&self, token: Token, what: &str, valid: &[&str], noun: &str) -> CaseError {
         let tail = suggest(token.text, valid, noun);
         let found = quote(token.text);
-        self.lex
-            .error_at(token.start, format!("unknown {what} {found}{tail}"))
+        self.lex.error_at(token.start, format!("unknown {what} {found}{tail}"))
     }
 
     /// A block closed before the count it announced; pointed at the closing brace.
-    fn too_few(
-        &self,
-        brace: Token,
-        label: &str,
-        count: usize,
-        given: usize,
-        noun: &str,
-    ) -> CaseError {
+    fn too_few(&self, brace: Token, label: &str, count: usize, given: usize, noun: &str) -> CaseError {
         let plural = |n: usize| {
-            if n == 1 {
-                noun.to_owned()
-            } else {
-                format!("{noun}s")
-            }
+            if n == 1 { noun.to_owned() } else { format!("{noun}s") }
         };
         self.lex.error_at(
             brace.start,

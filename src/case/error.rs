@@ -46,17 +46,11 @@ pub enum CaseError {
         source: io::Error,
     },
     #[error("{location}: invalid TOML: {message}")]
-    Syntax {
-        location: SourceLocation,
-        message: String,
-    },
+    Syntax { location: SourceLocation, message: String },
     /// Public so that later stages (loading an OBJ named by `ObjectSpec::location`) can report
     /// their failures in the same `file:line:column` form.
     #[error("{location}: {message}")]
-    Invalid {
-        location: SourceLocation,
-        message: String,
-    },
+    Invalid { location: SourceLocation, message: String },
     /// Something absent from the file, which therefore has no line to point at.
     #[error("{}: {message}", file.display())]
     Missing { file: PathBuf, message: String },
@@ -65,9 +59,7 @@ pub enum CaseError {
 impl CaseError {
     pub fn location(&self) -> Option<&SourceLocation> {
         match self {
-            CaseError::Syntax { location, .. } | CaseError::Invalid { location, .. } => {
-                Some(location)
-            }
+            CaseError::Syntax { location, .. } | CaseError::Invalid { location, .. } => Some(location),
             CaseError::Read { .. } | CaseError::Missing { .. } => None,
         }
     }

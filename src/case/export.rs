@@ -81,12 +81,8 @@ fn defaults(profile: Profile) -> Case {
          up = [0, 1, 0]\nfov = 30\n[materials.m]\n",
         string(profile_name(profile))
     );
-    parse(
-        &skeleton,
-        Path::new("defaults.toml"),
-        &LoadOptions::default(),
-    )
-    .expect("the skeleton case is valid for every profile")
+    parse(&skeleton, Path::new("defaults.toml"), &LoadOptions::default())
+        .expect("the skeleton case is valid for every profile")
 }
 
 struct Writer<'a> {
@@ -104,36 +100,18 @@ impl Writer<'_> {
             r.height
         );
         let depth = |range: Option<(f64, f64)>| {
-            range.map_or_else(String::new, |(min, max)| {
-                format!("[{}, {}]", number(min), number(max))
-            })
+            range.map_or_else(String::new, |(min, max)| format!("[{}, {}]", number(min), number(max)))
         };
         out += &only_changed(&[
             ("bounces", r.bounces != d.bounces, r.bounces.to_string()),
             ("shadows", r.shadows != d.shadows, r.shadows.to_string()),
             ("samples", r.samples != d.samples, r.samples.to_string()),
             ("seed", r.seed != d.seed, r.seed.to_string()),
-            (
-                "filter",
-                r.filter != d.filter,
-                string(r.filter.name()),
-            ),
-            (
-                "depth_range",
-                r.depth_range != d.depth_range,
-                depth(r.depth_range),
-            ),
+            ("filter", r.filter != d.filter, string(r.filter.name())),
+            ("depth_range", r.depth_range != d.depth_range, depth(r.depth_range)),
             ("normals", r.normals != d.normals, r.normals.to_string()),
-            (
-                "tonemap",
-                r.tonemap != d.tonemap,
-                string(tonemap_name(r.tonemap)),
-            ),
-            (
-                "precision",
-                r.precision != d.precision,
-                string(r.precision.name()),
-            ),
+            ("tonemap", r.tonemap != d.tonemap, string(tonemap_name(r.tonemap))),
+            ("precision", r.precision != d.precision, string(r.precision.name())),
         ]);
         out
     }
@@ -148,11 +126,7 @@ impl Writer<'_> {
                 number(t.fail_fraction),
             ),
             ("rmse", t.rmse != d.rmse, number(t.rmse)),
-            (
-                "max",
-                t.max != d.max,
-                t.max.map_or_else(String::new, number),
-            ),
+            ("max", t.max != d.max, t.max.map_or_else(String::new, number)),
         ]);
         section("[tolerance]", keys)
     }
@@ -163,11 +137,7 @@ impl Writer<'_> {
         let keys = only_changed(&[
             ("color", b.color != d.color, vec3(&b.color)),
             ("ambient", b.ambient != d.ambient, vec3(&b.ambient)),
-            (
-                "cube_map",
-                b.cube_map != d.cube_map,
-                cube_map.unwrap_or_default(),
-            ),
+            ("cube_map", b.cube_map != d.cube_map, cube_map.unwrap_or_default()),
         ]);
         section("[background]", keys)
     }
@@ -325,11 +295,7 @@ fn op(op: &TransformOp) -> String {
         TransformOp::RotateZ(d) => ("rotate_z", number(*d)),
         TransformOp::Rotate { axis, degrees } => (
             "rotate",
-            format!(
-                "{{ axis = {}, degrees = {} }}",
-                vec3(axis),
-                number(*degrees)
-            ),
+            format!("{{ axis = {}, degrees = {} }}", vec3(axis), number(*degrees)),
         ),
         TransformOp::Matrix(m) => ("matrix", list(m.iter().map(|v| number(*v)))),
     };
@@ -380,10 +346,7 @@ fn string(s: &str) -> String {
 
 /// Bare when TOML allows it, quoted otherwise.
 fn key(name: &str) -> String {
-    let bare = !name.is_empty()
-        && name
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
+    let bare = !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
     if bare { name.to_owned() } else { string(name) }
 }
 
@@ -393,7 +356,6 @@ fn profile_name(profile: Profile) -> &'static str {
         Profile::Mit6837 => "mit6837",
     }
 }
-
 
 fn tonemap_name(tonemap: Tonemap) -> &'static str {
     match tonemap {

@@ -24,8 +24,8 @@ pub use error::{CaseError, SourceLocation};
 pub use export::case_to_toml;
 pub use sections::{MAX_BOUNCES, MAX_IMAGE_SIZE};
 pub use spec::{
-    BackgroundSpec, CameraSpec, Case, LightSpec, MaterialSpec, ObjectSpec, RenderSettings,
-    ShapeSpec, Tolerance, TransformOp, composite_matrix,
+    BackgroundSpec, CameraSpec, Case, LightSpec, MaterialSpec, ObjectSpec, RenderSettings, ShapeSpec, Tolerance,
+    TransformOp, composite_matrix,
 };
 
 // The located TOML readers and the key suggestions, shared with the grading rubric so that both
@@ -70,20 +70,13 @@ pub fn parse(source: &str, path: &Path, options: &LoadOptions) -> Result<Case, C
         dir: path.parent().unwrap_or(Path::new("")),
         options,
     };
-    let top = Table::new(
-        &doc,
-        "the case file".to_owned(),
-        root.span(),
-        root.get_ref(),
-    );
+    let top = Table::new(&doc, "the case file".to_owned(), root.span(), root.get_ref());
     top.check_keys(TOP_LEVEL_KEYS)?;
     let materials = sections::materials(top.get("materials"))?;
     Ok(Case {
         name: case_name(path),
         path: path.to_path_buf(),
-        description: top.read("description", None, |f| {
-            f.string().map(|s| Some(s.to_owned()))
-        })?,
+        description: top.read("description", None, |f| f.string().map(|s| Some(s.to_owned())))?,
         render: sections::render(&doc, top.get("render"))?,
         tolerance: sections::tolerance(&doc, top.get("tolerance"))?,
         camera: sections::camera(&doc, top.get("camera"))?,
@@ -96,5 +89,7 @@ pub fn parse(source: &str, path: &Path, options: &LoadOptions) -> Result<Case, C
 
 /// A case is named after its file's stem: `cases/spheres.toml` renders `spheres.exr`.
 pub(crate) fn case_name(path: &Path) -> String {
-    path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default()
+    path.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default()
 }

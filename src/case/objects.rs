@@ -33,17 +33,13 @@ type ReadOp = fn(&Field) -> Result<TransformOp>;
 const OPS: &[(&str, ReadOp)] = &[
     ("translate", |f| Ok(TransformOp::Translate(f.vec3()?))),
     ("scale", |f| Ok(TransformOp::Scale(f.vec3()?))),
-    ("uniform_scale", |f| {
-        Ok(TransformOp::UniformScale(f.number()?))
-    }),
+    ("uniform_scale", |f| Ok(TransformOp::UniformScale(f.number()?))),
     ("rotate_x", |f| Ok(TransformOp::RotateX(f.number()?))),
     ("rotate_y", |f| Ok(TransformOp::RotateY(f.number()?))),
     ("rotate_z", |f| Ok(TransformOp::RotateZ(f.number()?))),
     ("rotate", rotate),
     ("matrix", |f| {
-        Ok(TransformOp::Matrix(
-            f.numbers("an array of 16 numbers, row-major")?,
-        ))
+        Ok(TransformOp::Matrix(f.numbers("an array of 16 numbers, row-major")?))
     }),
 ];
 
@@ -101,7 +97,10 @@ fn material(f: &Field, materials: &[MaterialSpec]) -> Result<usize> {
                 "unknown material `{name}`: no materials are defined; add a [materials.{name}] table"
             ))
         } else {
-            f.error(format!("unknown material `{name}`{}", suggest(name, &names, "materials")))
+            f.error(format!(
+                "unknown material `{name}`{}",
+                suggest(name, &names, "materials")
+            ))
         }
     })
 }
@@ -143,8 +142,7 @@ pub(crate) fn file_problem(path: &Path) -> Option<String> {
 }
 
 fn transform(f: &Field) -> Result<Vec<TransformOp>> {
-    let entries =
-        f.array("an array of ops, like [{ translate = [0, 1, 0] }, { rotate_y = 45 }]")?;
+    let entries = f.array("an array of ops, like [{ translate = [0, 1, 0] }, { rotate_y = 45 }]")?;
     let ops = entries.iter().map(op).collect::<Result<Vec<_>>>()?;
     check_invertible(f, &ops)?;
     Ok(ops)
@@ -193,10 +191,9 @@ fn rotate(f: &Field) -> Result<TransformOp> {
 fn check_invertible(f: &Field, ops: &[TransformOp]) -> Result<()> {
     match singularity(ops) {
         None => Ok(()),
-        Some(problem) => Err(f.doc.error_at(
-            &f.key_span,
-            format!("{} {problem}; found {}", f.name, f.excerpt()),
-        )),
+        Some(problem) => Err(f
+            .doc
+            .error_at(&f.key_span, format!("{} {problem}; found {}", f.name, f.excerpt()))),
     }
 }
 
@@ -213,20 +210,10 @@ pub(crate) fn singularity(ops: &[TransformOp]) -> Option<String> {
     // matrix, so only its linear part is judged; a projective `matrix` is judged whole.
     let (determinant, scale, relative) = if m.row(3) == DVec4::W {
         let linear = DMat3::from_mat4(m);
-        let scale = linear
-            .to_cols_array()
-            .iter()
-            .fold(0.0, |a: f64, b| a.max(b.abs()));
-        (
-            linear.determinant(),
-            scale,
-            (linear * scale.recip()).determinant(),
-        )
+        let scale = linear.to_cols_array().iter().fold(0.0, |a: f64, b| a.max(b.abs()));
+        (linear.determinant(), scale, (linear * scale.recip()).determinant())
     } else {
-        let scale = m
-            .to_cols_array()
-            .iter()
-            .fold(0.0, |a: f64, b| a.max(b.abs()));
+        let scale = m.to_cols_array().iter().fold(0.0, |a: f64, b| a.max(b.abs()));
         (m.determinant(), scale, (m * scale.recip()).determinant())
     };
     let invertible = relative.abs() > SINGULAR && m.inverse().is_finite();

@@ -20,11 +20,7 @@ pub const MAX_BOUNCES: i64 = 1024;
 const CUBE_FACES: [&str; 6] = ["left", "right", "up", "down", "front", "back"];
 
 /// An optional `[name]` section as a table; an absent one reads as all defaults.
-fn section<'a, 'i>(
-    doc: &'a Doc<'a>,
-    field: Option<Field<'a, 'i>>,
-    what: &str,
-) -> Result<Table<'a, 'i>> {
+fn section<'a, 'i>(doc: &'a Doc<'a>, field: Option<Field<'a, 'i>>, what: &str) -> Result<Table<'a, 'i>> {
     field.map_or_else(|| Ok(Table::empty(doc, what)), |f| f.table(what.to_owned()))
 }
 
@@ -55,10 +51,7 @@ pub(crate) fn render<'a>(doc: &'a Doc<'a>, field: Option<Field<'a, '_>>) -> Resu
         width,
         height,
         bounces: t.read("bounces", 0, |f| {
-            f.integer_in(
-                0..=MAX_BOUNCES,
-                &format!("must be between 0 and {MAX_BOUNCES}"),
-            )
+            f.integer_in(0..=MAX_BOUNCES, &format!("must be between 0 and {MAX_BOUNCES}"))
         })?,
         shadows: t.read("shadows", false, Field::boolean)?,
         samples: t.read("samples", 1, samples)?,
@@ -92,9 +85,7 @@ fn size(doc: &Doc, f: &Field) -> Result<(u32, u32)> {
         *slot = if doc.options.allow_huge_images {
             item.integer_in(1..=i64::from(u32::MAX), "must be between 1 and 4294967295")?
         } else {
-            let requirement = format!(
-                "must be between 1 and {MAX_IMAGE_SIZE} (pass --force to render larger images)"
-            );
+            let requirement = format!("must be between 1 and {MAX_IMAGE_SIZE} (pass --force to render larger images)");
             item.integer_in(1..=MAX_IMAGE_SIZE, &requirement)?
         };
     }
@@ -111,9 +102,7 @@ fn samples(f: &Field) -> Result<u32> {
     let root = n.isqrt();
     if root > LARGEST_ROOT {
         let most = LARGEST_ROOT * LARGEST_ROOT;
-        return Err(f.invalid(format!(
-            "must be at most {most} ({LARGEST_ROOT}×{LARGEST_ROOT})"
-        )));
+        return Err(f.invalid(format!("must be at most {most} ({LARGEST_ROOT}×{LARGEST_ROOT})")));
     }
     if root * root != n {
         let up = root + 1;
@@ -187,17 +176,12 @@ pub(crate) fn is_parallel(direction: [f64; 3], up: [f64; 3]) -> bool {
     sine < 1e-9
 }
 
-pub(crate) fn background<'a>(
-    doc: &'a Doc<'a>,
-    field: Option<Field<'a, '_>>,
-) -> Result<BackgroundSpec> {
+pub(crate) fn background<'a>(doc: &'a Doc<'a>, field: Option<Field<'a, '_>>) -> Result<BackgroundSpec> {
     let t = section(doc, field, "[background]")?;
     t.check_keys(&["color", "ambient", "cube_map"])?;
     let cube_map = t.read("cube_map", None, |f| {
         if t.get("color").is_some() {
-            return Err(
-                f.error("give either color or cube_map, not both: a cube map replaces the colour")
-            );
+            return Err(f.error("give either color or cube_map, not both: a cube map replaces the colour"));
         }
         let path = doc.dir.join(f.string()?);
         match cube_map_problem(&path) {
@@ -238,11 +222,7 @@ enum LightKind {
 
 const LIGHT_KINDS: &[(&str, &[&str], LightKind)] = &[
     ("point", &["position", "color", "falloff"], LightKind::Point),
-    (
-        "directional",
-        &["direction", "color"],
-        LightKind::Directional,
-    ),
+    ("directional", &["direction", "color"], LightKind::Directional),
 ];
 
 pub(crate) fn lights(field: Option<Field>) -> Result<Vec<LightSpec>> {

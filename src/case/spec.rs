@@ -58,7 +58,12 @@ pub struct Tolerance {
 impl Tolerance {
     /// What a case without `[tolerance]` gets, and what `goldray diff` applies to two EXRs: one
     /// definition, so the suite and the command judge alike.
-    pub const DEFAULT: Tolerance = Tolerance { pixel: 0.01, fail_fraction: 0.001, rmse: 0.002, max: None };
+    pub const DEFAULT: Tolerance = Tolerance {
+        pixel: 0.01,
+        fail_fraction: 0.001,
+        rmse: 0.002,
+        max: None,
+    };
 }
 
 /// `direction` and `up` have nonzero length and are not parallel; `fov` is in (0, 180) degrees.
@@ -88,10 +93,7 @@ pub enum LightSpec {
         falloff: f64,
     },
     /// `direction` points from the light into the scene and has nonzero length.
-    Directional {
-        direction: [f64; 3],
-        color: [f64; 3],
-    },
+    Directional { direction: [f64; 3], color: [f64; 3] },
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -22,11 +22,7 @@ fn locations_are_one_based_and_count_characters() {
     assert_eq!(location(text, 7), (2, 1));
     let quote = text.find('"').unwrap();
     assert_eq!(location(text, quote), (2, 6), "é is one column, two bytes");
-    assert_eq!(
-        location(text, quote + 2),
-        (2, 7),
-        "inside ü falls back to its start"
-    );
+    assert_eq!(location(text, quote + 2), (2, 7), "inside ü falls back to its start");
     assert_eq!(location(text, 10_000), (3, 2), "past the end clamps");
     let l = SourceLocation {
         file: "cases/a.toml".into(),
@@ -48,14 +44,8 @@ fn suggestions_are_close_or_absent() {
         suggest("raduis", &keys, "keys"),
         "; did you mean `radius`? valid keys: center, radius, material"
     );
-    assert_eq!(
-        suggest("zzz", &keys, "keys"),
-        "; valid keys: center, radius, material"
-    );
-    assert_eq!(
-        suggest("zzz", &[], "materials"),
-        "; valid materials: (none)"
-    );
+    assert_eq!(suggest("zzz", &keys, "keys"), "; valid keys: center, radius, material");
+    assert_eq!(suggest("zzz", &[], "materials"), "; valid materials: (none)");
 }
 
 fn apply(ops: &[TransformOp], p: [f64; 3]) -> DVec3 {
@@ -68,15 +58,9 @@ fn close(a: DVec3, b: [f64; 3]) -> bool {
 
 #[test]
 fn the_last_op_is_applied_first() {
-    let ops = [
-        TransformOp::Translate([1.0, 0.0, 0.0]),
-        TransformOp::UniformScale(2.0),
-    ];
+    let ops = [TransformOp::Translate([1.0, 0.0, 0.0]), TransformOp::UniformScale(2.0)];
     assert!(close(apply(&ops, [1.0, 0.0, 0.0]), [3.0, 0.0, 0.0]));
-    let ops = [
-        TransformOp::UniformScale(2.0),
-        TransformOp::Translate([1.0, 0.0, 0.0]),
-    ];
+    let ops = [TransformOp::UniformScale(2.0), TransformOp::Translate([1.0, 0.0, 0.0])];
     assert!(close(apply(&ops, [1.0, 0.0, 0.0]), [4.0, 0.0, 0.0]));
     assert_eq!(composite_matrix(&[]), DMat4::IDENTITY);
 }
@@ -118,19 +102,14 @@ fn matrices_are_row_major_as_written() {
         apply(std::slice::from_ref(&op), [0.0, 0.0, 0.0]),
         [4.0, 0.0, 0.0]
     ));
-    assert!(
-        close(apply(&[op], [0.0, 1.0, 0.0]), [6.0, 1.0, 0.0]),
-        "x' = x + 2y + 4"
-    );
+    assert!(close(apply(&[op], [0.0, 1.0, 0.0]), [6.0, 1.0, 0.0]), "x' = x + 2y + 4");
 }
 
-const CAMERA: &str =
-    "[camera]\ncenter = [0, 0, 10]\ndirection = [0, 0, -1]\nup = [0, 1, 0]\nfov = 30\n";
+const CAMERA: &str = "[camera]\ncenter = [0, 0, 10]\ndirection = [0, 0, -1]\nup = [0, 1, 0]\nfov = 30\n";
 
 fn transform_result(transform: &str) -> Result<Case, CaseError> {
-    let source = format!(
-        "{CAMERA}[[object]]\nkind = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\ntransform = {transform}\n"
-    );
+    let source =
+        format!("{CAMERA}[[object]]\nkind = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\ntransform = {transform}\n");
     parse(&source, Path::new("t.toml"), &LoadOptions::default())
 }
 
@@ -138,21 +117,11 @@ fn transform_result(transform: &str) -> Result<Case, CaseError> {
 fn invertibility_ignores_translation_and_uniform_scale_but_not_flattening() {
     assert!(transform_result("[{ translate = [1e12, 0, 0] }]").is_ok());
     assert!(transform_result("[{ uniform_scale = 1e-9 }]").is_ok());
-    assert!(
-        transform_result(
-            "[{ uniform_scale = 1e9 }, { rotate = { axis = [1, 2, 3], degrees = 17 } }]"
-        )
-        .is_ok()
-    );
+    assert!(transform_result("[{ uniform_scale = 1e9 }, { rotate = { axis = [1, 2, 3], degrees = 17 } }]").is_ok());
     let projective = "[{ matrix = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0.5, 1] }]";
     assert!(transform_result(projective).is_ok());
     let flat = "[{ matrix = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0] }]";
-    assert!(
-        transform_result(flat)
-            .unwrap_err()
-            .to_string()
-            .contains("singular")
-    );
+    assert!(transform_result(flat).unwrap_err().to_string().contains("singular"));
     assert!(
         transform_result("[{ scale = [1, 1e-14, 1] }]")
             .unwrap_err()
@@ -174,10 +143,7 @@ fn long_values_are_shortened_in_messages() {
     let message = transform_result(&format!("[{{ matrix = [{many}] }}]"))
         .unwrap_err()
         .to_string();
-    assert!(
-        message.contains("but has 100 elements, found [1, 1,"),
-        "{message}"
-    );
+    assert!(message.contains("but has 100 elements, found [1, 1,"), "{message}");
     assert!(message.ends_with('…'), "{message}");
     assert!(message.chars().count() < 200, "{message}");
 }

@@ -98,10 +98,8 @@ impl<'a, 'i> Table<'a, 'i> {
 
     pub fn require(&self, name: &str) -> Result<Field<'a, 'i>> {
         self.get(name).ok_or_else(|| {
-            self.doc.error_at(
-                &self.span,
-                format!("{} is missing required key `{name}`", self.what),
-            )
+            self.doc
+                .error_at(&self.span, format!("{} is missing required key `{name}`", self.what))
         })
     }
 
@@ -112,11 +110,7 @@ impl<'a, 'i> Table<'a, 'i> {
     /// Rejects the first key not in `allowed`. `owner` names the other kinds a stray key belongs
     /// to, because `offset` on a sphere is a different mistake from a typo and deserves a
     /// different hint.
-    pub fn check_keys_with(
-        &self,
-        allowed: &[&str],
-        owner: impl Fn(&str) -> Option<String>,
-    ) -> Result<()> {
+    pub fn check_keys_with(&self, allowed: &[&str], owner: impl Fn(&str) -> Option<String>) -> Result<()> {
         let Some(field) = self.fields().find(|f| !allowed.contains(&f.name.as_str())) else {
             return Ok(());
         };
@@ -127,22 +121,14 @@ impl<'a, 'i> Table<'a, 'i> {
                  {what}: {}",
                 allowed.join(", ")
             ),
-            None => format!(
-                "unknown key `{name}` in {what}{}",
-                suggest(name, allowed, "keys")
-            ),
+            None => format!("unknown key `{name}` in {what}{}", suggest(name, allowed, "keys")),
         };
         Err(self.doc.error_at(&field.key_span, message))
     }
 
     /// Reads the required `kind` string of a tagged table (an object or a light), renames the
     /// table after it, and checks the keys against `common` plus that kind's own.
-    pub fn kind<K: Copy>(
-        &mut self,
-        noun: &str,
-        common: &[&str],
-        kinds: &[(&str, &[&str], K)],
-    ) -> Result<K> {
+    pub fn kind<K: Copy>(&mut self, noun: &str, common: &[&str], kinds: &[(&str, &[&str], K)]) -> Result<K> {
         let field = self.require("kind")?;
         let written = field.string()?;
         let Some(&(name, own, kind)) = kinds.iter().find(|(k, _, _)| *k == written) else {
@@ -169,12 +155,7 @@ impl<'a, 'i> Table<'a, 'i> {
     }
 
     /// `read` applied to the key if present, else `default`: how every optional setting is read.
-    pub fn read<T>(
-        &self,
-        name: &str,
-        default: T,
-        read: impl FnOnce(&Field<'a, 'i>) -> Result<T>,
-    ) -> Result<T> {
+    pub fn read<T>(&self, name: &str, default: T, read: impl FnOnce(&Field<'a, 'i>) -> Result<T>) -> Result<T> {
         self.get(name).map_or(Ok(default), |f| read(&f))
     }
 }
@@ -202,11 +183,7 @@ impl<'a, 'i> Field<'a, 'i> {
 
     /// "`requirement`, found `what was written`", the shape of nearly every value error.
     pub fn invalid(&self, requirement: impl fmt::Display) -> CaseError {
-        self.error(format!(
-            "{} {requirement}, found {}",
-            self.name,
-            self.excerpt()
-        ))
+        self.error(format!("{} {requirement}, found {}", self.name, self.excerpt()))
     }
 
     fn wrong_type(&self, expected: &str) -> CaseError {
@@ -222,10 +199,7 @@ impl<'a, 'i> Field<'a, 'i> {
     pub fn number(&self) -> Result<f64> {
         let value = match self.value.get_ref() {
             DeValue::Integer(_) => self.integer()? as f64,
-            DeValue::Float(f) => f
-                .as_str()
-                .parse::<f64>()
-                .map_err(|_| self.wrong_type("a number"))?,
+            DeValue::Float(f) => f.as_str().parse::<f64>().map_err(|_| self.wrong_type("a number"))?,
             _ => return Err(self.wrong_type("a number")),
         };
         if value.is_finite() {
@@ -239,16 +213,11 @@ impl<'a, 'i> Field<'a, 'i> {
         let DeValue::Integer(i) = self.value.get_ref() else {
             return Err(self.wrong_type("an integer"));
         };
-        i64::from_str_radix(i.as_str(), i.radix())
-            .map_err(|_| self.invalid("must be an integer that fits in 64 bits"))
+        i64::from_str_radix(i.as_str(), i.radix()).map_err(|_| self.invalid("must be an integer that fits in 64 bits"))
     }
 
     /// An integer in `range`, converted to the type the renderer stores it in.
-    pub fn integer_in<T: TryFrom<i64>>(
-        &self,
-        range: RangeInclusive<i64>,
-        requirement: &str,
-    ) -> Result<T> {
+    pub fn integer_in<T: TryFrom<i64>>(&self, range: RangeInclusive<i64>, requirement: &str) -> Result<T> {
         let value = self.integer()?;
         match T::try_from(value) {
             Ok(v) if range.contains(&value) => Ok(v),
@@ -273,10 +242,7 @@ impl<'a, 'i> Field<'a, 'i> {
     }
 
     pub fn string(&self) -> Result<&'a str> {
-        self.value
-            .get_ref()
-            .as_str()
-            .ok_or_else(|| self.wrong_type("a string"))
+        self.value.get_ref().as_str().ok_or_else(|| self.wrong_type("a string"))
     }
 
     pub fn table(&self, what: String) -> Result<Table<'a, 'i>> {

@@ -126,9 +126,7 @@ pub fn diff_files(args: &DiffArgs) -> Result<Comparison, CompareError> {
 /// A closed pipe (`goldray diff … | head`) must not turn a verdict into a panic.
 fn print_stdout(text: &str) {
     let mut stdout = std::io::stdout().lock();
-    let _ = stdout
-        .write_all(text.as_bytes())
-        .and_then(|()| stdout.flush());
+    let _ = stdout.write_all(text.as_bytes()).and_then(|()| stdout.flush());
 }
 
 /// Thresholds: a finite number ≥ 0 (a NaN threshold would pass

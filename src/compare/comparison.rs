@@ -184,12 +184,7 @@ fn mismatch(expected: &Layout, actual: &Layout) -> String {
             Encoding::Linear => "EXR",
             Encoding::Code8 => "8-bit",
         };
-        format!(
-            "{}x{} {kind} with channels {}",
-            l.width,
-            l.height,
-            l.channels.join(" ")
-        )
+        format!("{}x{} {kind} with channels {}", l.width, l.height, l.channels.join(" "))
     };
     let mut differences = Vec::new();
     if (expected.width, expected.height) != (actual.width, actual.height) {

@@ -27,36 +27,32 @@ pub fn diff_heatmap(expected: &Image, actual: &Image, pixel_threshold: f64) -> O
         return None;
     }
     let width = expected.width as usize;
-    Some(RgbImage::from_fn(
-        expected.width,
-        expected.height,
-        |x, y| {
-            let i = y as usize * width + x as usize;
-            let mut largest = 0.0_f64;
-            let mut failing = false;
-            for (e, a) in expected.channels.iter().zip(&actual.channels) {
-                match difference(e.values[i], a.values[i], e.infinity_is_a_value()) {
-                    Difference::Broken => return Rgb(NON_FINITE),
-                    diff @ (Difference::Finite(_) | Difference::Coverage) => {
-                        failing |= diff.exceeds(pixel_threshold);
-                        if let Difference::Finite(d) = diff {
-                            largest = largest.max(d);
-                        }
+    Some(RgbImage::from_fn(expected.width, expected.height, |x, y| {
+        let i = y as usize * width + x as usize;
+        let mut largest = 0.0_f64;
+        let mut failing = false;
+        for (e, a) in expected.channels.iter().zip(&actual.channels) {
+            match difference(e.values[i], a.values[i], e.infinity_is_a_value()) {
+                Difference::Broken => return Rgb(NON_FINITE),
+                diff @ (Difference::Finite(_) | Difference::Coverage) => {
+                    failing |= diff.exceeds(pixel_threshold);
+                    if let Difference::Finite(d) = diff {
+                        largest = largest.max(d);
                     }
                 }
             }
-            if failing {
-                return Rgb(FAILING);
-            }
-            let [r, g, b] = expected.preview.get_pixel(x, y).0.map(f32::from);
-            let grey = (0.2126 * r + 0.7152 * g + 0.0722 * b) * BACKDROP;
-            if largest == 0.0 {
-                return Rgb([grey as u8; 3]);
-            }
-            let t = ((largest / pixel_threshold).log10() / DECADES + 1.0).clamp(0.0, 1.0) as f32;
-            let hot = [255.0, 40.0 + 215.0 * t, 0.0];
-            let weight = 0.4 + 0.6 * t;
-            Rgb(hot.map(|h| (grey + (h - grey) * weight).round() as u8))
-        },
-    ))
+        }
+        if failing {
+            return Rgb(FAILING);
+        }
+        let [r, g, b] = expected.preview.get_pixel(x, y).0.map(f32::from);
+        let grey = (0.2126 * r + 0.7152 * g + 0.0722 * b) * BACKDROP;
+        if largest == 0.0 {
+            return Rgb([grey as u8; 3]);
+        }
+        let t = ((largest / pixel_threshold).log10() / DECADES + 1.0).clamp(0.0, 1.0) as f32;
+        let hot = [255.0, 40.0 + 215.0 * t, 0.0];
+        let weight = 0.4 + 0.6 * t;
+        Rgb(hot.map(|h| (grey + (h - grey) * weight).round() as u8))
+    }))
 }

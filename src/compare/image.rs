@@ -84,10 +84,7 @@ impl Image {
             channels: COLOR_CHANNELS
                 .iter()
                 .enumerate()
-                .map(|(c, &name)| Channel {
-                    name,
-                    values: plane(c),
-                })
+                .map(|(c, &name)| Channel { name, values: plane(c) })
                 .collect(),
             preview: picture,
         }
@@ -97,11 +94,10 @@ impl Image {
     /// "miss" values, and comparing those invented values would hide a channel-set mismatch.
     pub fn from_exr_bytes(bytes: &[u8], source: impl Into<PathBuf>) -> Result<Image, CompareError> {
         let source = source.into();
-        let meta =
-            MetaData::read_from_buffered(bytes, false).map_err(|e| CompareError::ExrHeader {
-                path: source.clone(),
-                source: e,
-            })?;
+        let meta = MetaData::read_from_buffered(bytes, false).map_err(|e| CompareError::ExrHeader {
+            path: source.clone(),
+            source: e,
+        })?;
         let film = decode_exr(bytes).map_err(|e| CompareError::Exr {
             path: source.clone(),
             source: e,
@@ -117,11 +113,9 @@ impl Image {
     pub fn from_png_bytes(bytes: &[u8], source: impl Into<PathBuf>) -> Result<Image, CompareError> {
         let source = source.into();
         let decoded =
-            image::load_from_memory_with_format(bytes, image::ImageFormat::Png).map_err(|e| {
-                CompareError::Png {
-                    path: source.clone(),
-                    source: e,
-                }
+            image::load_from_memory_with_format(bytes, image::ImageFormat::Png).map_err(|e| CompareError::Png {
+                path: source.clone(),
+                source: e,
             })?;
         Ok(Image::from_rgb8(decoded.into_rgb8(), source))
     }

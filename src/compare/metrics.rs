@@ -138,12 +138,7 @@ pub(super) fn measure(expected: &Image, actual: &Image, pixel_threshold: f64) ->
                 Difference::Broken => {
                     match &mut non_finite {
                         Some(found) => found.count += 1,
-                        None => {
-                            non_finite = Some(NonFinite {
-                                count: 1,
-                                first: at(),
-                            })
-                        }
+                        None => non_finite = Some(NonFinite { count: 1, first: at() }),
                     }
                     continue;
                 }

@@ -157,15 +157,8 @@ impl fmt::Display for Breach {
         let (measured, allowed) = (self.measured, self.allowed);
         match self.limit {
             Limit::NonFinite => {
-                let plural = if measured == 1.0 {
-                    "value is"
-                } else {
-                    "values are"
-                };
-                write!(
-                    f,
-                    "non-finite: {measured} {plural} NaN or infinite in one image only"
-                )?;
+                let plural = if measured == 1.0 { "value is" } else { "values are" };
+                write!(f, "non-finite: {measured} {plural} NaN or infinite in one image only")?;
             }
             Limit::FailFraction => write!(
                 f,

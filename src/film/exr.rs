@@ -7,8 +7,8 @@ use std::path::Path;
 
 use ::exr::meta::MetaData;
 use ::exr::prelude::{
-    AnyChannel, AnyChannels, Blocks, Compression, Encoding, FlatSamples, Image, Layer,
-    LayerAttributes, LineOrder, ReadChannels, ReadLayers, WritableImage, read,
+    AnyChannel, AnyChannels, Blocks, Compression, Encoding, FlatSamples, Image, Layer, LayerAttributes, LineOrder,
+    ReadChannels, ReadLayers, WritableImage, read,
 };
 
 use super::Film;
@@ -98,10 +98,7 @@ pub(super) fn encode_exr_named(film: &Film, file: &str) -> Result<Vec<u8>, Outpu
 /// can use. Depth alone may be `+inf`: that is how a miss is stored.
 fn check_film(film: &Film, file: &str) -> Result<(), OutputError> {
     let pixels = film.width as usize * film.height as usize;
-    if film.width == 0
-        || film.height == 0
-        || [film.color.len(), film.depth.len(), film.normal.len()] != [pixels; 3]
-    {
+    if film.width == 0 || film.height == 0 || [film.color.len(), film.depth.len(), film.normal.len()] != [pixels; 3] {
         return Err(OutputError::FilmShape {
             file: file.to_owned(),
             width: film.width,
@@ -113,9 +110,7 @@ fn check_film(film: &Film, file: &str) -> Result<(), OutputError> {
     }
     let pixel_values = film.color.iter().zip(&film.depth).zip(&film.normal);
     for (i, ((color, &depth), normal)) in pixel_values.enumerate() {
-        let values = [
-            color[0], color[1], color[2], depth, normal[0], normal[1], normal[2],
-        ];
+        let values = [color[0], color[1], color[2], depth, normal[0], normal[1], normal[2]];
         let bad = values.iter().zip(CHANNELS).find(|&(&value, channel)| {
             if channel == "Z" {
                 value.is_nan()
@@ -149,10 +144,7 @@ fn decode_exr_named(bytes: &[u8], file: &str) -> Result<Film, OutputError> {
 
     let meta = MetaData::read_from_buffered(bytes, false).map_err(invalid)?;
     let claimed = meta.headers.iter().try_fold(0usize, |total, header| {
-        let layer = header
-            .layer_size
-            .area()
-            .checked_mul(header.channels.bytes_per_pixel)?;
+        let layer = header.layer_size.area().checked_mul(header.channels.bytes_per_pixel)?;
         total.checked_add(layer)
     });
     if claimed.is_none_or(|bytes| bytes > MAX_DECODE_BYTES) {
@@ -237,10 +229,7 @@ mod tests {
         assert!(encode_exr(&film).is_ok());
         film.depth[2] = f32::NAN;
         let message = encode_exr(&film).unwrap_err().to_string();
-        assert!(
-            message.contains("pixel (0, 1)") && message.contains(" Z "),
-            "{message}"
-        );
+        assert!(message.contains("pixel (0, 1)") && message.contains(" Z "), "{message}");
     }
 
     #[test]
@@ -250,20 +239,14 @@ mod tests {
         let at = bytes.windows(key.len()).position(|w| w == key).unwrap() + key.len() + 4;
         bytes[at + 8..at + 16].copy_from_slice(&[[0xff, 0xff, 0, 0]; 2].concat());
         let error = decode_exr(&bytes).unwrap_err();
-        assert!(
-            matches!(error, OutputError::UnsupportedExr { .. }),
-            "{error}"
-        );
+        assert!(matches!(error, OutputError::UnsupportedExr { .. }), "{error}");
     }
 
     #[test]
     fn mismatched_buffers_and_empty_films_are_refused() {
         let mut film = Film::new(2, 2);
         film.depth.pop();
-        assert!(matches!(
-            encode_exr(&film),
-            Err(OutputError::FilmShape { .. })
-        ));
+        assert!(matches!(encode_exr(&film), Err(OutputError::FilmShape { .. })));
         assert!(matches!(
             encode_exr(&Film::new(0, 4)),
             Err(OutputError::FilmShape { .. })

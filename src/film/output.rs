@@ -57,22 +57,13 @@ pub enum OutputError {
     },
 
     #[error("cannot encode {file}: {source}")]
-    EncodeExr {
-        file: String,
-        source: ::exr::error::Error,
-    },
+    EncodeExr { file: String, source: ::exr::error::Error },
 
     #[error("cannot encode {file}: {source}")]
-    EncodePng {
-        file: String,
-        source: image::ImageError,
-    },
+    EncodePng { file: String, source: image::ImageError },
 
     #[error("{file} is not a readable EXR: {source}")]
-    DecodeExr {
-        file: String,
-        source: ::exr::error::Error,
-    },
+    DecodeExr { file: String, source: ::exr::error::Error },
 
     #[error("{file} cannot be read as a film: {reason}")]
     UnsupportedExr { file: String, reason: String },
@@ -107,9 +98,7 @@ pub fn write_outputs(
     options: &OutputOptions,
 ) -> Result<Vec<PathBuf>, OutputError> {
     if name.is_empty() || Path::new(name).file_name() != Some(name.as_ref()) {
-        return Err(OutputError::InvalidName {
-            name: name.to_owned(),
-        });
+        return Err(OutputError::InvalidName { name: name.to_owned() });
     }
     let path = |suffix: &str| dir.join(format!("{name}{suffix}"));
     let png = |path: PathBuf, image: RgbImage| -> Result<(PathBuf, Vec<u8>), OutputError> {
@@ -119,21 +108,12 @@ pub fn write_outputs(
 
     let exr_path = path(".exr");
     let exr = encode_exr_named(film, &exr_path.display().to_string())?;
-    let mut files = vec![
-        (exr_path, exr),
-        png(path(".png"), color_image(film, options.tonemap))?,
-    ];
+    let mut files = vec![(exr_path, exr), png(path(".png"), color_image(film, options.tonemap))?];
     if let Some((min, max)) = options.depth_range {
-        files.push(png(
-            path("_depth.png"),
-            depth_image(film, min, max, options.tonemap),
-        )?);
+        files.push(png(path("_depth.png"), depth_image(film, min, max, options.tonemap))?);
     }
     if options.normals {
-        files.push(png(
-            path("_normals.png"),
-            normals_image(film, options.tonemap),
-        )?);
+        files.push(png(path("_normals.png"), normals_image(film, options.tonemap))?);
     }
 
     let pending: Vec<(&Path, &[u8])> = files.iter().map(|(p, b)| (p.as_path(), &b[..])).collect();
@@ -210,8 +190,8 @@ fn commit(dir: &Path, files: &[(&Path, &[u8])]) -> Result<(), OutputError> {
         // The last target is never rolled back, so its old content needs no backup.
         let needs_backup = i + 1 < files.len();
         let backup = staging.path().join(format!("{i}.previous"));
-        let result = preserve(target, &backup, needs_backup)
-            .and_then(|previous| fs::rename(temp, target).map(|()| previous));
+        let result =
+            preserve(target, &backup, needs_backup).and_then(|previous| fs::rename(temp, target).map(|()| previous));
         match result {
             Ok(previous) => installed.push(Installed { target, previous }),
             Err(source) => {
@@ -246,11 +226,7 @@ fn preserve(target: &Path, backup: &Path, needs_backup: bool) -> io::Result<Opti
 
 /// Undoes `installed` newest first. Should that fail too, the staging directory is kept so that
 /// the previous content is not lost, and the error says where it is.
-fn roll_back(
-    installed: Vec<Installed>,
-    staging: tempfile::TempDir,
-    failure: OutputError,
-) -> OutputError {
+fn roll_back(installed: Vec<Installed>, staging: tempfile::TempDir, failure: OutputError) -> OutputError {
     for Installed { target, previous } in installed.into_iter().rev() {
         let undone = match &previous {
             Some(backup) => fs::rename(backup, target),
@@ -284,10 +260,7 @@ mod tests {
             path: PathBuf::from("out/a.exr"),
             source: io::Error::from(io::ErrorKind::PermissionDenied),
         };
-        assert_eq!(
-            error.to_string(),
-            "cannot write out/a.exr: permission denied"
-        );
+        assert_eq!(error.to_string(), "cannot write out/a.exr: permission denied");
         let error = OutputError::MissingChannel {
             file: "a.exr".into(),
             channel: "R",
@@ -304,10 +277,7 @@ mod tests {
         };
         for name in ["", "..", "a/b", "/abs"] {
             let result = write_outputs(Path::new("unused"), name, &Film::new(1, 1), &options);
-            assert!(
-                matches!(result, Err(OutputError::InvalidName { .. })),
-                "{name:?}"
-            );
+            assert!(matches!(result, Err(OutputError::InvalidName { .. })), "{name:?}");
         }
         assert!(!Path::new("unused").exists());
     }

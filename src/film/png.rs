@@ -116,10 +116,7 @@ mod tests {
         let above = 1.055 * boundary.powf(1.0 / 2.4) - 0.055;
         assert!((srgb_encode(boundary) - above).abs() < 1e-5);
         assert_eq!(colour(boundary, Tonemap::Srgb), 10); // 0.04045 · 255 = 10.3
-        assert_eq!(
-            colour(f32::from_bits(boundary.to_bits() + 1), Tonemap::Srgb),
-            10
-        );
+        assert_eq!(colour(f32::from_bits(boundary.to_bits() + 1), Tonemap::Srgb), 10);
     }
 
     #[test]
@@ -161,23 +158,14 @@ mod tests {
     #[test]
     fn normals_map_minus_one_to_one_onto_the_byte_range() {
         let film = film_with([0.0; 3], 3.0, [-1.0, 1.0, 0.0]);
-        assert_eq!(
-            normals_image(&film, Tonemap::Clamp).get_pixel(0, 0).0,
-            [0, 255, 127]
-        );
-        assert_eq!(
-            normals_image(&film, Tonemap::Srgb).get_pixel(0, 0).0,
-            [0, 255, 128]
-        );
+        assert_eq!(normals_image(&film, Tonemap::Clamp).get_pixel(0, 0).0, [0, 255, 127]);
+        assert_eq!(normals_image(&film, Tonemap::Srgb).get_pixel(0, 0).0, [0, 255, 128]);
     }
 
     #[test]
     fn a_missed_pixel_has_grey_127_normals_with_clamp() {
         let film = Film::new(2, 1);
-        assert_eq!(
-            normals_image(&film, Tonemap::Clamp).get_pixel(1, 0).0,
-            [127; 3]
-        );
+        assert_eq!(normals_image(&film, Tonemap::Clamp).get_pixel(1, 0).0, [127; 3]);
     }
 
     #[test]
@@ -185,10 +173,7 @@ mod tests {
         let mut film = Film::new(1, 2);
         film.color[0] = [1.0; 3];
         let image = color_image(&film, Tonemap::Clamp);
-        assert_eq!(
-            (image.get_pixel(0, 0).0, image.get_pixel(0, 1).0),
-            ([255; 3], [0; 3])
-        );
+        assert_eq!((image.get_pixel(0, 0).0, image.get_pixel(0, 1).0), ([255; 3], [0; 3]));
     }
 
     #[test]
@@ -198,15 +183,7 @@ mod tests {
         film.depth.clear();
         film.normal.clear();
         assert_eq!(color_image(&film, Tonemap::Clamp).get_pixel(1, 1).0, [0; 3]);
-        assert_eq!(
-            depth_image(&film, 0.0, 1.0, Tonemap::Clamp)
-                .get_pixel(1, 1)
-                .0,
-            [0; 3]
-        );
-        assert_eq!(
-            normals_image(&film, Tonemap::Clamp).get_pixel(1, 1).0,
-            [127; 3]
-        );
+        assert_eq!(depth_image(&film, 0.0, 1.0, Tonemap::Clamp).get_pixel(1, 1).0, [0; 3]);
+        assert_eq!(normals_image(&film, Tonemap::Clamp).get_pixel(1, 1).0, [127; 3]);
     }
 }

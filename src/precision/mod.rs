@@ -43,14 +43,14 @@ macro_rules! instantiate {
         pub type Mat3 = $mat3;
         pub type Mat4 = $mat4;
 
-        #[path = "../real.rs"]
-        pub mod real;
         #[path = "../geometry/mod.rs"]
         pub mod geometry;
-        #[path = "../scene/mod.rs"]
-        pub mod scene;
+        #[path = "../real.rs"]
+        pub mod real;
         #[path = "../render/mod.rs"]
         pub mod render;
+        #[path = "../scene/mod.rs"]
+        pub mod scene;
     };
 }
 

@@ -73,11 +73,34 @@ mod tests {
     #[test]
     fn adds_and_merges_by_summing_each_kind() {
         let mut a = RayCounts::default();
-        a.add(&RayCounts { camera: 2, aov: 1, shadow: 0, reflection: 4 });
-        a.add(&RayCounts { camera: 1, aov: 0, shadow: 3, reflection: 0 });
-        let b = RayCounts { camera: 1, aov: 0, shadow: 0, reflection: 1 };
+        a.add(&RayCounts {
+            camera: 2,
+            aov: 1,
+            shadow: 0,
+            reflection: 4,
+        });
+        a.add(&RayCounts {
+            camera: 1,
+            aov: 0,
+            shadow: 3,
+            reflection: 0,
+        });
+        let b = RayCounts {
+            camera: 1,
+            aov: 0,
+            shadow: 0,
+            reflection: 1,
+        };
         let sum = a.merge(b);
-        assert_eq!(sum, RayCounts { camera: 4, aov: 1, shadow: 3, reflection: 5 });
+        assert_eq!(
+            sum,
+            RayCounts {
+                camera: 4,
+                aov: 1,
+                shadow: 3,
+                reflection: 5
+            }
+        );
         assert_eq!(sum.total(), 13);
         assert_eq!(std::mem::size_of::<NoCount>(), 0);
     }

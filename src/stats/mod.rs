@@ -145,7 +145,13 @@ impl RenderStats {
             seconds: phases,
             build,
             rays: PerKind::of(rays, |count| count),
-            mrays_per_second: PerKind::of(rays, |count| if seconds > 0.0 { count as f64 / seconds / 1e6 } else { 0.0 }),
+            mrays_per_second: PerKind::of(rays, |count| {
+                if seconds > 0.0 {
+                    count as f64 / seconds / 1e6
+                } else {
+                    0.0
+                }
+            }),
             peak_memory_bytes: peak_resident_bytes(),
         }
     }
@@ -154,7 +160,10 @@ impl RenderStats {
     pub fn write_json(&self, path: &Path) -> Result<(), StatsError> {
         let mut json = serde_json::to_vec_pretty(self)?;
         json.push(b'\n');
-        write_file_atomic(path, &json).map_err(|source| StatsError::Write { path: path.to_path_buf(), source })
+        write_file_atomic(path, &json).map_err(|source| StatsError::Write {
+            path: path.to_path_buf(),
+            source,
+        })
     }
 }
 
@@ -200,10 +209,21 @@ mod tests {
             &crate::case::LoadOptions::default(),
         )
         .unwrap();
-        let rays = RayCounts { camera: 3_000_000, aov: 0, shadow: 1_000_000, reflection: 0 };
-        let phases = Phases { render: Duration::from_secs(2), ..Phases::default() };
+        let rays = RayCounts {
+            camera: 3_000_000,
+            aov: 0,
+            shadow: 1_000_000,
+            reflection: 0,
+        };
+        let phases = Phases {
+            render: Duration::from_secs(2),
+            ..Phases::default()
+        };
         let stats = RenderStats::new(&case, phases, BuildStats::default(), &rays, 2);
-        assert_eq!((stats.case.as_str(), stats.width, stats.height, stats.threads), ("tiny", 200, 200, 2));
+        assert_eq!(
+            (stats.case.as_str(), stats.width, stats.height, stats.threads),
+            ("tiny", 200, 200, 2)
+        );
         assert_eq!(stats.mrays_per_second.camera, 1.5);
         assert_eq!(stats.mrays_per_second.shadow, 0.5);
         assert_eq!(stats.mrays_per_second.total, 2.0);

@@ -12,8 +12,16 @@ const VALUE_WIDTH: usize = 13;
 
 impl Display for RenderStats {
     fn fmt(&self, f: &mut Formatter<'_>) -> fmt::Result {
-        let threads = if self.threads == 1 { "1 thread".to_string() } else { format!("{} threads", self.threads) };
-        writeln!(f, "Statistics for {} ({}×{}, {threads})", self.case, self.width, self.height)?;
+        let threads = if self.threads == 1 {
+            "1 thread".to_string()
+        } else {
+            format!("{} threads", self.threads)
+        };
+        writeln!(
+            f,
+            "Statistics for {} ({}×{}, {threads})",
+            self.case, self.width, self.height
+        )?;
         let times = &self.seconds;
         heading(f, "Time", &[])?;
         row(f, 4, "parse", &[duration(times.parse)])?;
@@ -45,7 +53,16 @@ impl Display for RenderStats {
         } else {
             heading(f, "BVH", &["primitives", "nodes", "leaves"])?;
             for (name, bvh) in bvhs {
-                row(f, 4, &name, &[grouped(bvh.primitives as u64), grouped(bvh.nodes as u64), grouped(bvh.leaves as u64)])?;
+                row(
+                    f,
+                    4,
+                    &name,
+                    &[
+                        grouped(bvh.primitives as u64),
+                        grouped(bvh.nodes as u64),
+                        grouped(bvh.leaves as u64),
+                    ],
+                )?;
             }
         }
 
@@ -81,7 +98,11 @@ fn row(f: &mut Formatter<'_>, indent: usize, label: &str, values: &[String]) -> 
 /// Milliseconds below ten seconds, where renders of the shipped cases fall; seconds above.
 fn duration(duration: Duration) -> String {
     let seconds = duration.as_secs_f64();
-    if seconds < 10.0 { format!("{:.2} ms", seconds * 1e3) } else { format!("{seconds:.2} s") }
+    if seconds < 10.0 {
+        format!("{:.2} ms", seconds * 1e3)
+    } else {
+        format!("{seconds:.2} s")
+    }
 }
 
 /// `1234567` → `1,234,567`: ray counts run to billions.
@@ -98,7 +119,10 @@ pub(crate) fn grouped(n: u64) -> String {
 }
 
 fn file_name(path: &std::path::Path) -> String {
-    path.file_name().unwrap_or(path.as_os_str()).to_string_lossy().into_owned()
+    path.file_name()
+        .unwrap_or(path.as_os_str())
+        .to_string_lossy()
+        .into_owned()
 }
 
 #[cfg(test)]

@@ -77,7 +77,10 @@ pub struct TradeoffArgs {
 impl TradeoffArgs {
     pub fn options(&self) -> TradeoffOptions {
         TradeoffOptions {
-            out: self.out.clone().unwrap_or_else(|| PathBuf::from("tradeoff").join(case_name(&self.case))),
+            out: self
+                .out
+                .clone()
+                .unwrap_or_else(|| PathBuf::from("tradeoff").join(case_name(&self.case))),
             plan: SweepPlan {
                 samples: self.samples.clone(),
                 filters: self.filters.clone(),
@@ -120,7 +123,15 @@ pub fn run_tradeoff_command(args: &TradeoffArgs) -> Result<Tradeoff, TradeoffErr
 fn summary(t: &Tradeoff) -> String {
     let front: Vec<String> = t
         .front()
-        .map(|m| format!("{} ({} s, {} {})", m.setting.label(), significant(m.seconds), t.metric.name(), significant(t.metric.of(&m.errors))))
+        .map(|m| {
+            format!(
+                "{} ({} s, {} {})",
+                m.setting.label(),
+                significant(m.seconds),
+                t.metric.name(),
+                significant(t.metric.of(&m.errors))
+            )
+        })
         .collect();
     format!(
         "{} at {}×{}: {} settings against a {} spp reference ({} bounces, {} s)\nbounces: {}\nPareto front: {}",
@@ -137,7 +148,10 @@ fn summary(t: &Tradeoff) -> String {
 }
 
 fn parse_square(text: &str) -> Result<u32, String> {
-    let n: u32 = text.trim().parse().map_err(|_| format!("`{text}` is not a whole number"))?;
+    let n: u32 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{text}` is not a whole number"))?;
     let root = n.isqrt();
     if n == 0 || root * root != n {
         let up = root + 1;
@@ -160,13 +174,21 @@ fn parse_filter(text: &str) -> Result<Filter, String> {
 
 fn parse_precision(text: &str) -> Result<Precision, String> {
     let text = text.trim();
-    Precision::ALL.into_iter().find(|p| p.name() == text).ok_or_else(|| format!("`{text}` is not a precision: f32 or f64"))
+    Precision::ALL
+        .into_iter()
+        .find(|p| p.name() == text)
+        .ok_or_else(|| format!("`{text}` is not a precision: f32 or f64"))
 }
 
 fn parse_size(text: &str) -> Result<(u32, u32), String> {
     let usage = || format!("`{text}` is not a size: give WIDTHxHEIGHT, e.g. 64x48");
     let (width, height) = text.split_once(['x', 'X', '×']).ok_or_else(usage)?;
-    let side = |s: &str| s.trim().parse::<u32>().ok().filter(|&v| v >= 1 && i64::from(v) <= MAX_IMAGE_SIZE);
+    let side = |s: &str| {
+        s.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|&v| v >= 1 && i64::from(v) <= MAX_IMAGE_SIZE)
+    };
     match (side(width), side(height)) {
         (Some(w), Some(h)) => Ok((w, h)),
         _ => Err(format!("{} (each side between 1 and {MAX_IMAGE_SIZE})", usage())),

@@ -10,8 +10,8 @@ use super::sweep::Setting;
 use crate::case::{Case, Tolerance};
 use crate::compare::{Image, compare};
 use crate::film::Film;
-use crate::pipeline::render_options;
 use crate::options::{Filter, Precision, RenderOptions};
+use crate::pipeline::render_options;
 use crate::precision::{double, single};
 use crate::progress::Progress;
 use crate::stats::RayCounts;
@@ -97,7 +97,13 @@ impl<'a> Renderer<'a> {
             total += elapsed;
             runs += 1;
         }
-        Render { setting, film, seconds: fastest.as_secs_f64(), runs, rays }
+        Render {
+            setting,
+            film,
+            seconds: fastest.as_secs_f64(),
+            runs,
+            rays,
+        }
     }
 
     /// The pixel-area integral, as nearly as `samples` stratified samples get it (filter none),
@@ -108,11 +114,25 @@ impl<'a> Renderer<'a> {
     pub fn reference(&self, samples: u32, bounces: u32) -> Reference {
         let seed = self.case.render.seed.wrapping_add(1);
         let precision = REFERENCE_PRECISION;
-        let mut case = Setting { samples, filter: Filter::None, bounces, precision }.apply(self.case);
+        let mut case = Setting {
+            samples,
+            filter: Filter::None,
+            bounces,
+            precision,
+        }
+        .apply(self.case);
         case.render.seed = seed;
         let start = Instant::now();
         let (film, rays) = self.render_once(precision, &render_options(&case));
-        Reference { film, samples, bounces, precision, seed, seconds: start.elapsed().as_secs_f64(), rays }
+        Reference {
+            film,
+            samples,
+            bounces,
+            precision,
+            seed,
+            seconds: start.elapsed().as_secs_f64(),
+            rays,
+        }
     }
 }
 
@@ -133,8 +153,14 @@ pub fn errors(reference: &Film, film: &Film, setting: &Setting) -> Result<Errors
     let actual = Image::from_film(film, PathBuf::from(setting.label()));
     let metrics = compare(&expected, &actual, &Tolerance::DEFAULT)
         .metrics
-        .ok_or_else(|| TradeoffError::Mismatch { setting: setting.label() })?;
-    Ok(Errors { rmse: metrics.rmse, max: metrics.worst.map_or(0.0, |w| w.error()), flip: metrics.flip })
+        .ok_or_else(|| TradeoffError::Mismatch {
+            setting: setting.label(),
+        })?;
+    Ok(Errors {
+        rmse: metrics.rmse,
+        max: metrics.worst.map_or(0.0, |w| w.error()),
+        flip: metrics.flip,
+    })
 }
 
 /// Which error the plot and the Pareto front rank settings by.
@@ -192,7 +218,12 @@ pub struct Measurement {
 }
 
 impl Measurement {
-    pub fn of(render: &Render, reference: &Reference, in_grid: bool, in_bounce_sweep: bool) -> Result<Measurement, TradeoffError> {
+    pub fn of(
+        render: &Render,
+        reference: &Reference,
+        in_grid: bool,
+        in_bounce_sweep: bool,
+    ) -> Result<Measurement, TradeoffError> {
         Ok(Measurement {
             setting: render.setting,
             seconds: render.seconds,
@@ -206,6 +237,10 @@ impl Measurement {
 
     /// Millions of rays (all kinds) per second of the fastest run.
     pub fn mrays_per_second(&self) -> f64 {
-        if self.seconds > 0.0 { self.rays.total() as f64 / self.seconds / 1e6 } else { 0.0 }
+        if self.seconds > 0.0 {
+            self.rays.total() as f64 / self.seconds / 1e6
+        } else {
+            0.0
+        }
     }
 }

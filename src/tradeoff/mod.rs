@@ -112,7 +112,13 @@ pub struct Target {
 impl Tradeoff {
     /// The front's measurements, fastest first.
     pub fn front(&self) -> impl Iterator<Item = &Measurement> {
-        let mut front: Vec<&Measurement> = self.measurements.iter().zip(&self.pareto).filter(|(_, on)| **on).map(|(m, _)| m).collect();
+        let mut front: Vec<&Measurement> = self
+            .measurements
+            .iter()
+            .zip(&self.pareto)
+            .filter(|(_, on)| **on)
+            .map(|(m, _)| m)
+            .collect();
         front.sort_by(|a, b| a.seconds.total_cmp(&b.seconds));
         front.into_iter()
     }
@@ -120,7 +126,14 @@ impl Tradeoff {
     /// The `--target-flip` answer as a sentence, or `None` without a target.
     pub fn target_sentence(&self) -> Option<String> {
         let target = self.target?;
-        let describe = |m: &Measurement| format!("{} ({} s, FLIP {})", m.setting.label(), significant(m.seconds), significant(m.errors.flip));
+        let describe = |m: &Measurement| {
+            format!(
+                "{} ({} s, FLIP {})",
+                m.setting.label(),
+                significant(m.seconds),
+                significant(m.errors.flip)
+            )
+        };
         Some(match target.chosen {
             Some(index) => format!(
                 "the cheapest setting with FLIP mean ≤ {} is {}.",
@@ -170,7 +183,9 @@ pub fn measure_tradeoff(case: &Case, options: &TradeoffOptions) -> Result<Tradeo
     let target = options.target_flip.map(|flip| Target {
         flip,
         chosen: cheapest_within(&flips, flip),
-        best: (0..flips.len()).min_by(|&a, &b| flips[a].1.total_cmp(&flips[b].1)).unwrap_or(0),
+        best: (0..flips.len())
+            .min_by(|&a, &b| flips[a].1.total_cmp(&flips[b].1))
+            .unwrap_or(0),
     });
     Ok(Tradeoff {
         case_name: case.name.clone(),
@@ -190,7 +205,11 @@ pub fn measure_tradeoff(case: &Case, options: &TradeoffOptions) -> Result<Tradeo
 }
 
 fn progress_bar(show: bool) -> ProgressBar {
-    let target = if show && std::io::stderr().is_terminal() { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() };
+    let target = if show && std::io::stderr().is_terminal() {
+        ProgressDrawTarget::stderr()
+    } else {
+        ProgressDrawTarget::hidden()
+    };
     let bar = ProgressBar::with_draw_target(Some(0), target);
     if let Ok(style) = ProgressStyle::with_template("tradeoff [{bar:40}] {percent:>3}% {elapsed} (eta {eta}) {msg}") {
         bar.set_style(style.progress_chars("=> "));

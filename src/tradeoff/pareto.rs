@@ -49,14 +49,25 @@ mod tests {
             (9.0, 0.01), // the most accurate: on
             (0.5, 0.9),  // the very fastest: on
         ];
-        assert_eq!(pareto_front(&points), [true, true, false, true, false, false, true, true]);
+        assert_eq!(
+            pareto_front(&points),
+            [true, true, false, true, false, false, true, true]
+        );
     }
 
     #[test]
     fn a_slower_setting_is_not_on_the_front_for_an_error_smaller_only_by_rounding() {
         let points = [(1.0, 0.0245), (1.2, 0.024_499_99), (1.3, 0.0244)];
-        assert_eq!(pareto_front(&points), [true, false, true], "0.4% better is better; 4e-7 is not");
-        assert_eq!(pareto_front(&[(1.0, 0.5), (1.0, 0.500_01)]), [true, true], "as costly and as good: both");
+        assert_eq!(
+            pareto_front(&points),
+            [true, false, true],
+            "0.4% better is better; 4e-7 is not"
+        );
+        assert_eq!(
+            pareto_front(&[(1.0, 0.5), (1.0, 0.500_01)]),
+            [true, true],
+            "as costly and as good: both"
+        );
     }
 
     #[test]
@@ -70,9 +81,17 @@ mod tests {
     fn the_target_picks_the_cheapest_point_that_meets_it() {
         let points = [(5.0, 0.01), (1.0, 0.2), (3.0, 0.05), (2.0, 0.06), (4.0, 0.04)];
         assert_eq!(cheapest_within(&points, 0.05), Some(2), "0.05 meets a limit of 0.05");
-        assert_eq!(cheapest_within(&points, 0.045), Some(4), "the cheapest that meets it, not the best");
+        assert_eq!(
+            cheapest_within(&points, 0.045),
+            Some(4),
+            "the cheapest that meets it, not the best"
+        );
         assert_eq!(cheapest_within(&points, 1.0), Some(1));
-        assert_eq!(cheapest_within(&[(2.0, 0.1), (2.0, 0.0)], 0.1), Some(0), "the first on a tie");
+        assert_eq!(
+            cheapest_within(&[(2.0, 0.1), (2.0, 0.0)], 0.1),
+            Some(0),
+            "the first on a tie"
+        );
         assert_eq!(cheapest_within(&points, 0.001), None);
     }
 }

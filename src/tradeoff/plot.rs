@@ -48,7 +48,9 @@ struct Curve {
 /// Draws the plot and encodes it as an 8-bit RGB PNG marked with [`SOFTWARE`].
 pub fn plot_png(t: &Tradeoff) -> Result<Vec<u8>, TradeoffError> {
     if !font_registered() {
-        return Err(TradeoffError::Plot("the bundled font DejaVu Sans does not load".to_owned()));
+        return Err(TradeoffError::Plot(
+            "the bundled font DejaVu Sans does not load".to_owned(),
+        ));
     }
     let mut pixels = vec![255u8; (WIDTH * HEIGHT * 3) as usize];
     draw(t, &mut pixels).map_err(|e| TradeoffError::Plot(e.to_string()))?;
@@ -60,7 +62,11 @@ pub fn is_our_png(bytes: &[u8]) -> bool {
     let mut decoder = png::Decoder::new(Cursor::new(bytes));
     decoder.set_ignore_text_chunk(false);
     decoder.read_info().is_ok_and(|reader| {
-        reader.info().uncompressed_latin1_text.iter().any(|t| t.keyword == "Software" && t.text == SOFTWARE)
+        reader
+            .info()
+            .uncompressed_latin1_text
+            .iter()
+            .any(|t| t.keyword == "Software" && t.text == SOFTWARE)
     })
 }
 
@@ -89,7 +95,10 @@ fn position(m: &Measurement, t: &Tradeoff, floor: (f64, f64)) -> (f64, f64) {
 
 /// Half the smallest positive value, or `fallback` when there is none.
 fn floor_of(values: impl Iterator<Item = f64>, fallback: f64) -> f64 {
-    values.filter(|v| *v > 0.0).fold(None, |low: Option<f64>, v| Some(low.map_or(v, |l| l.min(v)))).map_or(fallback, |v| v / 2.0)
+    values
+        .filter(|v| *v > 0.0)
+        .fold(None, |low: Option<f64>, v| Some(low.map_or(v, |l| l.min(v))))
+        .map_or(fallback, |v| v / 2.0)
 }
 
 /// The grid's curves (one per precision and filter, labelled by samples per pixel) and the
@@ -117,7 +126,10 @@ fn curves(t: &Tradeoff, floor: (f64, f64)) -> Vec<Curve> {
                 filter.name(),
                 t.bounces.enough()
             ),
-            points: members.iter().map(|m| (position(m, t, floor), m.setting.samples.to_string())).collect(),
+            points: members
+                .iter()
+                .map(|m| (position(m, t, floor), m.setting.samples.to_string()))
+                .collect(),
             dashed: false,
         });
     }
@@ -131,7 +143,10 @@ fn curves(t: &Tradeoff, floor: (f64, f64)) -> Vec<Curve> {
             t.base.samples,
             t.base.filter.name()
         ),
-        points: bounces.iter().map(|m| (position(m, t, floor), format!("b{}", m.setting.bounces))).collect(),
+        points: bounces
+            .iter()
+            .map(|m| (position(m, t, floor), format!("b{}", m.setting.bounces)))
+            .collect(),
         dashed: true,
     });
     curves
@@ -161,7 +176,12 @@ fn place_label(placed: &mut Vec<Rect>, at: (i32, i32), size: (i32, i32)) -> Opti
     let (width, height) = size;
     // Clear of the ring around a front setting.
     let gap = 10;
-    let offsets = [(gap, -height - gap / 2), (gap, gap / 2), (-width - gap, -height - gap / 2), (-width - gap, gap / 2)];
+    let offsets = [
+        (gap, -height - gap / 2),
+        (gap, gap / 2),
+        (-width - gap, -height - gap / 2),
+        (-width - gap, gap / 2),
+    ];
     let overlaps = |a: &Rect, b: &Rect| a.0 < b.2 && b.0 < a.2 && a.1 < b.3 && b.1 < a.3;
     let rect = offsets
         .iter()
@@ -178,7 +198,11 @@ fn tick(value: f64) -> String {
     }
     let decimals = (2 - value.abs().log10().floor() as i32).max(0) as usize;
     let text = format!("{value:.decimals$}");
-    if text.contains('.') { text.trim_end_matches('0').trim_end_matches('.').to_owned() } else { text }
+    if text.contains('.') {
+        text.trim_end_matches('0').trim_end_matches('.').to_owned()
+    } else {
+        text
+    }
 }
 
 fn draw(t: &Tradeoff, pixels: &mut [u8]) -> Result<(), Box<dyn std::error::Error>> {
@@ -189,8 +213,12 @@ fn draw(t: &Tradeoff, pixels: &mut [u8]) -> Result<(), Box<dyn std::error::Error
         floor_of(t.measurements.iter().map(|m| t.metric.of(&m.errors)), 1e-6),
     );
     let all: Vec<(f64, f64)> = t.measurements.iter().map(|m| position(m, t, floor)).collect();
-    let (x_min, x_max) = all.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| (lo.min(p.0), hi.max(p.0)));
-    let (y_min, y_max) = all.iter().fold((f64::MAX, f64::MIN), |(lo, hi), p| (lo.min(p.1), hi.max(p.1)));
+    let (x_min, x_max) = all
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(lo, hi), p| (lo.min(p.0), hi.max(p.0)));
+    let (y_min, y_max) = all
+        .iter()
+        .fold((f64::MAX, f64::MIN), |(lo, hi), p| (lo.min(p.1), hi.max(p.1)));
 
     let caption = format!(
         "{}: {} against time ({} spp reference)",
@@ -204,7 +232,10 @@ fn draw(t: &Tradeoff, pixels: &mut [u8]) -> Result<(), Box<dyn std::error::Error
         .x_label_area_size(52)
         .y_label_area_size(76)
         // Room above the points for the legend, and beside them for the labels.
-        .build_cartesian_2d((x_min / 1.6..x_max * 2.0).log_scale(), (y_min / 1.6..y_max * 4.0).log_scale())?;
+        .build_cartesian_2d(
+            (x_min / 1.6..x_max * 2.0).log_scale(),
+            (y_min / 1.6..y_max * 4.0).log_scale(),
+        )?;
     chart
         .configure_mesh()
         .x_desc("render time (seconds, log scale)")
@@ -217,12 +248,25 @@ fn draw(t: &Tradeoff, pixels: &mut [u8]) -> Result<(), Box<dyn std::error::Error
         .bold_line_style(RGBColor(200, 200, 200))
         .draw()?;
 
-    let mut front: Vec<(f64, f64)> = all.iter().zip(&t.pareto).filter(|(_, on)| **on).map(|(p, _)| *p).collect();
+    let mut front: Vec<(f64, f64)> = all
+        .iter()
+        .zip(&t.pareto)
+        .filter(|(_, on)| **on)
+        .map(|(p, _)| *p)
+        .collect();
     front.sort_by(|a, b| a.0.total_cmp(&b.0).then(b.1.total_cmp(&a.1)));
     let front_style = RGBColor(40, 40, 40).stroke_width(2);
     chart
-        .draw_series(DashedLineSeries::new(staircase(&front), 5, 4, RGBColor(90, 90, 90).stroke_width(1)))?
-        .label(format!("Pareto front by {}: nothing is both faster and better", t.metric.name()))
+        .draw_series(DashedLineSeries::new(
+            staircase(&front),
+            5,
+            4,
+            RGBColor(90, 90, 90).stroke_width(1),
+        ))?
+        .label(format!(
+            "Pareto front by {}: nothing is both faster and better",
+            t.metric.name()
+        ))
         .legend(move |(x, y)| Circle::new((x, y), 7, front_style));
     chart.draw_series(front.iter().map(|&p| Circle::new(p, 9, front_style)))?;
 
@@ -236,7 +280,9 @@ fn draw(t: &Tradeoff, pixels: &mut [u8]) -> Result<(), Box<dyn std::error::Error
         } else {
             chart.draw_series(LineSeries::new(line, style))?
         };
-        drawn.label(curve.name).legend(move |(x, y)| PathElement::new(vec![(x - 12, y), (x + 12, y)], style));
+        drawn
+            .label(curve.name)
+            .legend(move |(x, y)| PathElement::new(vec![(x - 12, y), (x + 12, y)], style));
         chart.draw_series(curve.points.iter().map(|&(p, _)| Circle::new(p, 4, color.filled())))?;
         let label_style = TextStyle::from((FONT, 13).into_font()).color(&color);
         for (p, label) in curve.points {
@@ -279,9 +325,16 @@ mod tests {
         assert_eq!(first, (110, 85), "above right");
         let second = place_label(&mut placed, (102, 100), (20, 10)).unwrap();
         assert_eq!(second, (112, 105), "below right, since above right is taken");
-        assert!(place_label(&mut placed, (101, 100), (20, 10)).is_some(), "a left side is free");
+        assert!(
+            place_label(&mut placed, (101, 100), (20, 10)).is_some(),
+            "a left side is free"
+        );
         assert!(place_label(&mut placed, (101, 100), (20, 10)).is_some());
-        assert_eq!(place_label(&mut placed, (101, 100), (20, 10)), None, "all four sides are taken");
+        assert_eq!(
+            place_label(&mut placed, (101, 100), (20, 10)),
+            None,
+            "all four sides are taken"
+        );
         assert_eq!(placed.len(), 4);
     }
 

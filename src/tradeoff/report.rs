@@ -63,7 +63,10 @@ pub fn check_replaceable(dir: &Path, force: bool) -> Result<(), TradeoffError> {
             Ok(bytes) => bytes,
             Err(error) if error.kind() == io::ErrorKind::NotFound => continue,
             Err(source) if path.is_dir() => {
-                return Err(TradeoffError::Inspect { path, source: io::Error::new(source.kind(), "it is a directory") });
+                return Err(TradeoffError::Inspect {
+                    path,
+                    source: io::Error::new(source.kind(), "it is a directory"),
+                });
             }
             Err(source) => return Err(TradeoffError::Inspect { path, source }),
         };
@@ -84,7 +87,11 @@ pub fn check_replaceable(dir: &Path, force: bool) -> Result<(), TradeoffError> {
 pub fn write_report(tradeoff: &Tradeoff, dir: &Path) -> Result<Vec<PathBuf>, TradeoffError> {
     let [csv_path, markdown_path, plot_path] = report_paths(dir);
     let plot = plot_png(tradeoff)?;
-    let files = [(csv_path, csv(tradeoff).into_bytes()), (markdown_path, markdown(tradeoff).into_bytes()), (plot_path, plot)];
+    let files = [
+        (csv_path, csv(tradeoff).into_bytes()),
+        (markdown_path, markdown(tradeoff).into_bytes()),
+        (plot_path, plot),
+    ];
     for (path, bytes) in &files {
         write_file_atomic(path, bytes)?;
     }
@@ -187,7 +194,10 @@ pub fn markdown(t: &Tradeoff) -> String {
             if *on_front { "★" } else { "" },
         );
     }
-    let front: Vec<String> = t.front().map(|m| format!("{} ({} s)", m.setting.label(), significant(m.seconds))).collect();
+    let front: Vec<String> = t
+        .front()
+        .map(|m| format!("{} ({} s)", m.setting.label(), significant(m.seconds)))
+        .collect();
     let _ = writeln!(
         md,
         "\n**Pareto front** (★, by {}): the settings no other setting beats in both time and error, fastest \
@@ -227,7 +237,9 @@ pub fn bounce_sentence(t: &Tradeoff) -> String {
             plural(last - 1, "bounce"),
             if last == 2 { "is" } else { "are" },
         ),
-        (false, 0) => format!("{of}, only 0 bounces were rendered (--max-bounces 0): the sweep says nothing about depth. {asks}"),
+        (false, 0) => {
+            format!("{of}, only 0 bounces were rendered (--max-bounces 0): the sweep says nothing about depth. {asks}")
+        }
         (false, last) => format!(
             "{of}, the picture was still changing at the cap of {} (the last bounce moved a pixel by {}, over the \
              threshold {}); the grid is rendered at the cap. {asks}",
@@ -279,11 +291,17 @@ mod tests {
         assert!(check_replaceable(dir.path(), false).is_ok(), "our own earlier report");
         fs::write(dir.path().join(PLOT_FILE), b"someone's holiday photo").unwrap();
         let error = check_replaceable(dir.path(), false).unwrap_err();
-        assert!(matches!(&error, TradeoffError::NotOurs { path } if path.ends_with(PLOT_FILE)), "{error}");
+        assert!(
+            matches!(&error, TradeoffError::NotOurs { path } if path.ends_with(PLOT_FILE)),
+            "{error}"
+        );
         assert!(error.to_string().contains("--force"), "{error}");
         assert!(check_replaceable(dir.path(), true).is_ok());
         fs::write(dir.path().join(PLOT_FILE), b"").unwrap();
         fs::write(dir.path().join(MARKDOWN_FILE), "# my notes\n").unwrap();
-        assert!(matches!(check_replaceable(dir.path(), false), Err(TradeoffError::NotOurs { .. })));
+        assert!(matches!(
+            check_replaceable(dir.path(), false),
+            Err(TradeoffError::NotOurs { .. })
+        ));
     }
 }

@@ -42,7 +42,13 @@ impl Setting {
 
     /// A short name without commas (it is a CSV field and a plot label): `16spp gaussian 2b f32`.
     pub fn label(&self) -> String {
-        format!("{}spp {} {}b {}", self.samples, self.filter.name(), self.bounces, self.precision.name())
+        format!(
+            "{}spp {} {}b {}",
+            self.samples,
+            self.filter.name(),
+            self.bounces,
+            self.precision.name()
+        )
     }
 
     /// Camera rays per output pixel: the part of the cost known before rendering, which weighs
@@ -65,7 +71,6 @@ impl Setting {
         case
     }
 }
-
 
 /// The grid's filters unless told otherwise: both, since the filter is the costliest choice.
 pub const DEFAULT_FILTERS: [Filter; 2] = [Filter::None, Filter::Gaussian];
@@ -117,10 +122,15 @@ impl SweepPlan {
             return plan("the sweep needs at least one sample count, one filter and one precision".to_owned());
         }
         if let Some(&n) = self.samples.iter().find(|&&n| !is_square(n)) {
-            return plan(format!("samples {n}: every sample count must be a perfect square (1, 4, 9, 16, …)"));
+            return plan(format!(
+                "samples {n}: every sample count must be a perfect square (1, 4, 9, 16, …)"
+            ));
         }
         if !is_square(self.reference_samples) {
-            return plan(format!("reference samples {}: must be a perfect square", self.reference_samples));
+            return plan(format!(
+                "reference samples {}: must be a perfect square",
+                self.reference_samples
+            ));
         }
         let most = self.samples.iter().copied().max().unwrap_or(1);
         if self.reference_samples <= most {
@@ -132,11 +142,19 @@ impl SweepPlan {
         if i64::from(self.max_bounces) > MAX_BOUNCES {
             return plan(format!("max bounces {}: at most {MAX_BOUNCES}", self.max_bounces));
         }
-        if let Some((width, height)) = self.size.filter(|&(w, h)| w == 0 || h == 0 || i64::from(w.max(h)) > MAX_IMAGE_SIZE) {
-            return plan(format!("size {width}x{height}: each side must be between 1 and {MAX_IMAGE_SIZE}"));
+        if let Some((width, height)) = self
+            .size
+            .filter(|&(w, h)| w == 0 || h == 0 || i64::from(w.max(h)) > MAX_IMAGE_SIZE)
+        {
+            return plan(format!(
+                "size {width}x{height}: each side must be between 1 and {MAX_IMAGE_SIZE}"
+            ));
         }
         if !(self.bounce_threshold.is_finite() && self.bounce_threshold >= 0.0) {
-            return plan(format!("bounce threshold {}: must be a finite number ≥ 0", self.bounce_threshold));
+            return plan(format!(
+                "bounce threshold {}: must be a finite number ≥ 0",
+                self.bounce_threshold
+            ));
         }
         Ok(())
     }
@@ -147,7 +165,12 @@ impl SweepPlan {
         let mut grid = Vec::with_capacity(self.precisions.len() * self.filters.len() * self.samples.len());
         for &precision in &self.precisions {
             for &filter in &self.filters {
-                grid.extend(self.samples.iter().map(|&samples| Setting { samples, filter, bounces, precision }));
+                grid.extend(self.samples.iter().map(|&samples| Setting {
+                    samples,
+                    filter,
+                    bounces,
+                    precision,
+                }));
             }
         }
         grid
@@ -254,7 +277,11 @@ pub fn run_sweep(case: &Case, plan: &SweepPlan, bar: &ProgressBar) -> Result<Swe
         }
         measurements.push(Measurement::of(&render(setting), &reference, true, false)?);
     }
-    Ok(Sweep { reference, measurements, bounces: outcome })
+    Ok(Sweep {
+        reference,
+        measurements,
+        bounces: outcome,
+    })
 }
 
 #[cfg(test)]
@@ -262,7 +289,11 @@ mod tests {
     use super::*;
 
     fn plan(samples: &[u32], reference: u32) -> SweepPlan {
-        SweepPlan { samples: samples.to_vec(), reference_samples: reference, ..SweepPlan::default() }
+        SweepPlan {
+            samples: samples.to_vec(),
+            reference_samples: reference,
+            ..SweepPlan::default()
+        }
     }
 
     #[test]
@@ -272,13 +303,30 @@ mod tests {
         for precision in [Precision::F32, Precision::F64] {
             for filter in [Filter::None, Filter::Gaussian] {
                 for samples in [1, 4] {
-                    expected.push(Setting { samples, filter, bounces: 3, precision });
+                    expected.push(Setting {
+                        samples,
+                        filter,
+                        bounces: 3,
+                        precision,
+                    });
                 }
             }
         }
         assert_eq!(grid, expected);
-        let single = SweepPlan { precisions: vec![Precision::F64], filters: vec![Filter::None], ..plan(&[9], 16) };
-        assert_eq!(single.grid(0), [Setting { samples: 9, filter: Filter::None, bounces: 0, precision: Precision::F64 }]);
+        let single = SweepPlan {
+            precisions: vec![Precision::F64],
+            filters: vec![Filter::None],
+            ..plan(&[9], 16)
+        };
+        assert_eq!(
+            single.grid(0),
+            [Setting {
+                samples: 9,
+                filter: Filter::None,
+                bounces: 0,
+                precision: Precision::F64
+            }]
+        );
     }
 
     #[test]
@@ -289,16 +337,33 @@ mod tests {
         assert!(message(plan(&[1, 4], 4)).contains("more samples than every setting"));
         assert!(message(plan(&[1], 10)).contains("reference samples 10"));
         assert!(message(plan(&[], 16)).contains("at least one"));
-        assert!(message(SweepPlan { precisions: Vec::new(), ..SweepPlan::default() }).contains("one precision"));
-        let deep = SweepPlan { max_bounces: 5000, ..SweepPlan::default() };
+        assert!(
+            message(SweepPlan {
+                precisions: Vec::new(),
+                ..SweepPlan::default()
+            })
+            .contains("one precision")
+        );
+        let deep = SweepPlan {
+            max_bounces: 5000,
+            ..SweepPlan::default()
+        };
         assert!(message(deep).contains("at most 1024"));
-        let nan = SweepPlan { bounce_threshold: f64::NAN, ..SweepPlan::default() };
+        let nan = SweepPlan {
+            bounce_threshold: f64::NAN,
+            ..SweepPlan::default()
+        };
         assert!(message(nan).contains("bounce threshold"));
     }
 
     #[test]
     fn labels_name_every_axis_without_commas() {
-        let setting = Setting { samples: 16, filter: Filter::Gaussian, bounces: 2, precision: Precision::F64 };
+        let setting = Setting {
+            samples: 16,
+            filter: Filter::Gaussian,
+            bounces: 2,
+            precision: Precision::F64,
+        };
         assert_eq!(setting.label(), "16spp gaussian 2b f64");
         assert_eq!(setting.camera_rays_per_pixel(), 144);
     }

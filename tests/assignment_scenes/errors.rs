@@ -11,15 +11,9 @@ fn assert_error(source: &str, line: usize, column: usize, fragments: &[&str]) {
     };
     let message = error.to_string();
     let prefix = format!("{}:{line}:{column}: ", synthetic_path().display());
-    assert!(
-        message.starts_with(&prefix),
-        "expected {line}:{column} in: {message}"
-    );
+    assert!(message.starts_with(&prefix), "expected {line}:{column} in: {message}");
     for fragment in fragments {
-        assert!(
-            message.contains(fragment),
-            "expected {fragment:?} in: {message}"
-        );
+        assert!(message.contains(fragment), "expected {fragment:?} in: {message}");
     }
 }
 
@@ -54,10 +48,7 @@ fn unknown_keywords_suggest_the_nearest_valid_one() {
         &["unknown Background field `colour`; did you mean `color`?"],
     );
     assert_error(
-        &group_of(
-            1,
-            "  Transform { Scael 1 2 1 Sphere { center 0 0 0 radius 1 } }",
-        ),
+        &group_of(1, "  Transform { Scael 1 2 1 Sphere { center 0 0 0 radius 1 } }"),
         8,
         15,
         &["unknown transform op or object `Scael`; did you mean `Scale`?"],
@@ -119,10 +110,7 @@ fn material_index_must_name_a_material_of_the_block_before_it() {
         &with_camera(&source),
         7,
         36,
-        &[
-            "refers to no material",
-            "a Materials block must come before the Group",
-        ],
+        &["refers to no material", "a Materials block must come before the Group"],
     );
     let source = format!(
         "{ONE_MATERIAL}Group {{ numObjects 1 Transform {{ MaterialIndex 0 {} }} }}",
@@ -160,10 +148,7 @@ fn an_unclosed_block_is_reported_at_the_end_of_the_file() {
         &with_camera("Group { numObjects 1 Sphere {center 0 0 0 radius 1 } }"),
         7,
         29,
-        &[
-            "expected `{` after `Sphere`",
-            "braces need whitespace around them",
-        ],
+        &["expected `{` after `Sphere`", "braces need whitespace around them"],
     );
 }
 

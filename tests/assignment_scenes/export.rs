@@ -48,8 +48,8 @@ fn round_trip(case: &Case) -> String {
     fs::create_dir_all(path.parent().unwrap()).unwrap();
     let text = case_to_toml(case, &path);
     fs::write(&path, &text).unwrap();
-    let loaded = load(&path, &LoadOptions::default())
-        .unwrap_or_else(|e| panic!("the exported case must load: {e}\n{text}"));
+    let loaded =
+        load(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("the exported case must load: {e}\n{text}"));
     same_case(&loaded, case);
     text
 }
@@ -103,14 +103,8 @@ fn paths_that_cannot_be_made_relative_are_absolute() {
             other => obj.push(other),
         }
     }
-    assert!(
-        text.contains(&format!("obj = \"{}\"", obj.display())),
-        "{text}"
-    );
-    same_case(
-        &parse(&text, nowhere, &LoadOptions::default()).unwrap(),
-        &case,
-    );
+    assert!(text.contains(&format!("obj = \"{}\"", obj.display())), "{text}");
+    same_case(&parse(&text, nowhere, &LoadOptions::default()).unwrap(), &case);
 }
 
 #[test]
@@ -126,13 +120,7 @@ fn only_what_differs_from_the_defaults_is_written() {
     ] {
         assert!(text.contains(expected), "expected {expected:?} in:\n{text}");
     }
-    for absent in [
-        "[tolerance]",
-        "tonemap",
-        "samples",
-        "ambient",
-        "description",
-    ] {
+    for absent in ["[tolerance]", "tonemap", "samples", "ambient", "description"] {
         assert!(!text.contains(absent), "{absent} has its default:\n{text}");
     }
 }
@@ -181,10 +169,7 @@ fn a_tolerance_and_a_native_profile_are_written_when_they_differ() {
     case.tolerance.pixel = 0.02;
     case.description = Some("five spheres, \"quoted\"\nover two lines".to_owned());
     let text = round_trip(&case);
-    assert!(
-        text.contains("[tolerance]\npixel = 0.02\nmax = 0.5\n"),
-        "{text}"
-    );
+    assert!(text.contains("[tolerance]\npixel = 0.02\nmax = 0.5\n"), "{text}");
     assert!(
         text.contains("tonemap = \"clamp\""),
         "clamp is not the native default:\n{text}"

@@ -125,10 +125,7 @@ fn any_number() -> impl Strategy<Value = String> {
         any::<f64>().prop_map(|v| format!("{v:?}")),
         any::<f64>().prop_map(|v| format!("{v:e}")),
         (-4i32..5).prop_map(|v| v.to_string()),
-        prop::sample::select(vec![
-            "0", "-0", ".5", "-.25", "1e-300", "1e300", "0.1", "179.99"
-        ])
-        .prop_map(str::to_owned),
+        prop::sample::select(vec!["0", "-0", ".5", "-.25", "1e-300", "1e300", "0.1", "179.99"]).prop_map(str::to_owned),
     ]
 }
 

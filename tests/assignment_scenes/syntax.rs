@@ -44,14 +44,8 @@ fn crlf_and_tabs_read_like_newlines_and_spaces() {
     let original = parse_assignment_scene(&text, &path, &AssignmentOptions::default()).unwrap();
     let converted = parse_assignment_scene(&windows, &path, &AssignmentOptions::default()).unwrap();
     same_case(&converted, &original);
-    assert_eq!(
-        converted.objects[2].location.line, 48,
-        "\\r\\n is one line break"
-    );
-    assert_eq!(
-        converted.objects[2].location.column, 2,
-        "a tab is one column"
-    );
+    assert_eq!(converted.objects[2].location.line, 48, "\\r\\n is one line break");
+    assert_eq!(converted.objects[2].location.column, 2, "a tab is one column");
     let broken = windows.replace("radius 0.75\r\n", "radius x\r\n");
     let error = parse_assignment_scene(&broken, &path, &AssignmentOptions::default()).unwrap_err();
     let location = error.location().unwrap();
@@ -86,23 +80,14 @@ fn material_index_is_one_current_material_for_the_whole_file() {
         "a MaterialIndex inside a nested group still holds after it closes, as in the course"
     );
     let transformed = group_children(&case.objects[3]);
-    assert_eq!(
-        case.objects[3].transform,
-        [TransformOp::Translate([1.0, 0.0, 0.0])]
-    );
-    assert_eq!(
-        [transformed[0].material, transformed[1].material],
-        [Some(1), Some(2)]
-    );
+    assert_eq!(case.objects[3].transform, [TransformOp::Translate([1.0, 0.0, 0.0])]);
+    assert_eq!([transformed[0].material, transformed[1].material], [Some(1), Some(2)]);
 }
 
 #[test]
 fn matrix4f_is_read_by_columns_and_multiplies_from_the_left() {
     let translate_456 = "Matrix4f { 1 0 0 0  0 1 0 0  0 0 1 0  4 5 6 1 }";
-    let alone = one_object(&format!(
-        "Transform {{ {translate_456} {} }}",
-        sphere("0 0 0")
-    ));
+    let alone = one_object(&format!("Transform {{ {translate_456} {} }}", sphere("0 0 0")));
     assert_close(apply(&alone.transform, [0.0; 3]), [4.0, 5.0, 6.0]);
     let mixed = one_object(&format!(
         "Transform {{ UniformScale 2 {translate_456} ZRotate 90 {} }}",
@@ -123,10 +108,7 @@ fn matrix4f_is_read_by_columns_and_multiplies_from_the_left() {
 
 #[test]
 fn rotate_takes_an_unnormalised_axis_and_degrees() {
-    let object = one_object(&format!(
-        "Transform {{ Rotate {{ 0 0 5 90 }} {} }}",
-        sphere("0 0 0")
-    ));
+    let object = one_object(&format!("Transform {{ Rotate {{ 0 0 5 90 }} {} }}", sphere("0 0 0")));
     assert_eq!(
         object.transform,
         [TransformOp::Rotate {
@@ -145,10 +127,7 @@ fn nested_transforms_put_the_outer_ops_first() {
     ));
     assert_eq!(
         object.transform,
-        [
-            TransformOp::Translate([1.0, 0.0, 0.0]),
-            TransformOp::UniformScale(3.0)
-        ]
+        [TransformOp::Translate([1.0, 0.0, 0.0]), TransformOp::UniformScale(3.0)]
     );
     assert_close(apply(&object.transform, [1.0, 0.0, 0.0]), [4.0, 0.0, 0.0]);
 }
@@ -185,14 +164,6 @@ fn repeated_blocks_replace_or_update_the_earlier_ones_as_in_the_course() {
     assert_eq!(case.background.ambient, [0.5; 3]);
     assert_eq!(case.objects.len(), 2, "the last Group is the scene");
     assert_eq!(case.materials[1].diffuse, [0.0, 1.0, 0.0]);
-    assert_eq!(
-        case.objects[0].material,
-        Some(0),
-        "still the first block's material"
-    );
-    assert_eq!(
-        case.objects[1].material,
-        Some(1),
-        "index 0 of the latest block"
-    );
+    assert_eq!(case.objects[0].material, Some(0), "still the first block's material");
+    assert_eq!(case.objects[1].material, Some(1), "index 0 of the latest block");
 }

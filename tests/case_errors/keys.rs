@@ -48,11 +48,7 @@ fn unknown_keys_suggest_the_nearest_valid_key() {
         &["unknown key `lights` in the case file; did you mean `light`?"],
     );
     let message = error(&format!("[render]\n  smaples = 4\n{CAMERA}"));
-    assert_error(
-        &message,
-        "2:3",
-        &["`smaples` in [render]; did you mean `samples`?"],
-    );
+    assert_error(&message, "2:3", &["`smaples` in [render]; did you mean `samples`?"]);
     let message = error(&format!("{CAMERA}[materials.red]\nshinyness = 3\n"));
     assert_error(
         &message,
@@ -69,9 +65,7 @@ fn unknown_keys_suggest_the_nearest_valid_key() {
 
 #[test]
 fn keys_of_another_kind_are_rejected() {
-    let message = error(&format!(
-        "{CAMERA}[[object]]\nkind = \"sphere\"\noffset = 1\n"
-    ));
+    let message = error(&format!("{CAMERA}[[object]]\nkind = \"sphere\"\noffset = 1\n"));
     assert_error(
         &message,
         "8:1",
@@ -80,9 +74,7 @@ fn keys_of_another_kind_are_rejected() {
             "center, radius",
         ],
     );
-    let message = error(&format!(
-        "{CAMERA}[[light]]\nkind = \"directional\"\nfalloff = 1\n"
-    ));
+    let message = error(&format!("{CAMERA}[[light]]\nkind = \"directional\"\nfalloff = 1\n"));
     assert_error(
         &message,
         "8:1",
@@ -106,35 +98,15 @@ fn wrong_types_name_the_expected_type_and_the_value() {
     let message = error(&format!(
         "{CAMERA}[[object]]\nkind = \"sphere\"\ncenter = [0, 0, 0]\nradius = \"big\"\n"
     ));
-    assert_error(
-        &message,
-        "9:10",
-        &["radius must be a number, found string \"big\""],
-    );
+    assert_error(&message, "9:10", &["radius must be a number, found string \"big\""]);
     let message = error(&format!("[render]\nshadows = 1\n{CAMERA}"));
-    assert_error(
-        &message,
-        "2:11",
-        &["shadows must be true or false, found integer 1"],
-    );
+    assert_error(&message, "2:11", &["shadows must be true or false, found integer 1"]);
     let message = error(&format!("[render]\nbounces = 2.5\n{CAMERA}"));
-    assert_error(
-        &message,
-        "2:11",
-        &["bounces must be an integer, found float 2.5"],
-    );
+    assert_error(&message, "2:11", &["bounces must be an integer, found float 2.5"]);
     let message = error(&format!("[render]\nsize = [100, \"x\"]\n{CAMERA}"));
-    assert_error(
-        &message,
-        "2:14",
-        &["height must be an integer, found string \"x\""],
-    );
+    assert_error(&message, "2:14", &["height must be an integer, found string \"x\""]);
     let message = error("camera = 3\n");
-    assert_error(
-        &message,
-        "1:10",
-        &["camera must be a table, found integer 3"],
-    );
+    assert_error(&message, "1:10", &["camera must be a table, found integer 3"]);
 }
 
 #[test]
@@ -150,11 +122,7 @@ fn wrong_array_lengths_are_reported() {
     let message = error(&format!(
         "{CAMERA}[[object]]\nkind = \"triangle\"\nvertices = [[0, 0, 0], [1, 0, 0]]\n"
     ));
-    assert_error(
-        &message,
-        "8:12",
-        &["vertices must have 3 elements", "but has 2"],
-    );
+    assert_error(&message, "8:12", &["vertices must have 3 elements", "but has 2"]);
     let message = error(&format!(
         "{CAMERA}[[object]]\nkind = \"triangle\"\nvertices = [[0, 0, 0], [1, 0], [0, 1, 0]]\n"
     ));
@@ -187,9 +155,7 @@ fn unknown_names_list_the_valid_ones() {
     assert_error(
         &message,
         "7:8",
-        &[
-            "unknown object kind `sphre`; did you mean `sphere`? valid kinds: sphere, plane, triangle, mesh, group",
-        ],
+        &["unknown object kind `sphre`; did you mean `sphere`? valid kinds: sphere, plane, triangle, mesh, group"],
     );
     let message = error(&format!("{CAMERA}[[light]]\nkind = \"spot\"\n"));
     assert_error(
@@ -228,15 +194,7 @@ fn sections_of_the_wrong_shape_are_rejected() {
         &["light must be an array of tables, written [[light]], found table"],
     );
     let message = error(&format!("{CAMERA}[materials]\nred = 3\n"));
-    assert_error(
-        &message,
-        "7:7",
-        &["materials.red must be a table, found integer 3"],
-    );
+    assert_error(&message, "7:7", &["materials.red must be a table, found integer 3"]);
     let message = error(&format!("description = 5\n{CAMERA}"));
-    assert_error(
-        &message,
-        "1:15",
-        &["description must be a string, found integer 5"],
-    );
+    assert_error(&message, "1:15", &["description must be a string, found integer 5"]);
 }

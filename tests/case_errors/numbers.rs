@@ -9,35 +9,17 @@ use super::*;
 #[test]
 fn nan_and_infinity_are_rejected_everywhere() {
     let message = error(&format!("{CAMERA}[background]\nambient = [0, nan, 0]\n"));
-    assert_error(
-        &message,
-        "7:15",
-        &["ambient[1] must be a finite number, found nan"],
-    );
-    let message = error(
-        "[camera]\ncenter = [0, 0, 10]\ndirection = [0, 0, -1]\nup = [0, 1, 0]\nfov = -inf\n",
-    );
-    assert_error(
-        &message,
-        "5:7",
-        &["fov must be a finite number, found -inf"],
-    );
+    assert_error(&message, "7:15", &["ambient[1] must be a finite number, found nan"]);
+    let message = error("[camera]\ncenter = [0, 0, 10]\ndirection = [0, 0, -1]\nup = [0, 1, 0]\nfov = -inf\n");
+    assert_error(&message, "5:7", &["fov must be a finite number, found -inf"]);
     let message = error(&format!("[tolerance]\nrmse = +inf\n{CAMERA}"));
-    assert_error(
-        &message,
-        "2:8",
-        &["rmse must be a finite number, found +inf"],
-    );
+    assert_error(&message, "2:8", &["rmse must be a finite number, found +inf"]);
 }
 
 #[test]
 fn image_size_is_bounded_unless_forced() {
     let message = error(&format!("[render]\nsize = [0, 100]\n{CAMERA}"));
-    assert_error(
-        &message,
-        "2:9",
-        &["width must be between 1 and 16384", "found 0"],
-    );
+    assert_error(&message, "2:9", &["width must be between 1 and 16384", "found 0"]);
     let huge = format!("[render]\nsize = [100, 20000]\n{CAMERA}");
     let message = error(&huge);
     assert_error(
@@ -55,11 +37,7 @@ fn image_size_is_bounded_unless_forced() {
     .unwrap();
     assert_eq!((forced.render.width, forced.render.height), (100, 20000));
     let message = error(&format!("[render]\nsize = [1, 2, 3]\n{CAMERA}"));
-    assert_error(
-        &message,
-        "2:8",
-        &["size must be [width, height], but has 3 elements"],
-    );
+    assert_error(&message, "2:8", &["size must be [width, height], but has 3 elements"]);
 }
 
 #[test]
@@ -68,11 +46,7 @@ fn samples_must_be_a_positive_square() {
     assert_error(
         &message,
         "2:11",
-        &[
-            "samples must be a perfect square",
-            "9 (3×3) and 16 (4×4)",
-            "found 10",
-        ],
+        &["samples must be a perfect square", "9 (3×3) and 16 (4×4)", "found 10"],
     );
     let message = error(&format!("[render]\nsamples = 0\n{CAMERA}"));
     assert_error(
@@ -81,44 +55,27 @@ fn samples_must_be_a_positive_square() {
         &["samples must be a positive perfect square", "found 0"],
     );
     let message = error(&format!("[render]\nbounces = 1025\n{CAMERA}"));
-    assert_error(
-        &message,
-        "2:11",
-        &["bounces must be between 0 and 1024, found 1025"],
-    );
+    assert_error(&message, "2:11", &["bounces must be between 0 and 1024, found 1025"]);
     let message = error(&format!("[render]\nseed = -1\n{CAMERA}"));
     assert_error(&message, "2:8", &["seed must be ≥ 0, found -1"]);
 }
 
 #[test]
 fn physically_meaningless_numbers_are_rejected() {
-    let sphere = |radius: &str| {
-        format!("{CAMERA}[[object]]\nkind = \"sphere\"\ncenter = [0, 0, 0]\nradius = {radius}\n")
-    };
-    assert_error(
-        &error(&sphere("-1")),
-        "9:10",
-        &["radius must be ≥ 0, found -1"],
-    );
+    let sphere =
+        |radius: &str| format!("{CAMERA}[[object]]\nkind = \"sphere\"\ncenter = [0, 0, 0]\nradius = {radius}\n");
+    assert_error(&error(&sphere("-1")), "9:10", &["radius must be ≥ 0, found -1"]);
     assert!(try_parse(&sphere("0")).is_ok(), "a zero radius is allowed");
 
-    let message = error(&format!(
-        "{CAMERA}[materials.red]\ndiffuse = [1, -0.5, 0]\n"
-    ));
-    assert_error(
-        &message,
-        "7:15",
-        &["diffuse[1]", "must be ≥ 0", "found -0.5"],
-    );
+    let message = error(&format!("{CAMERA}[materials.red]\ndiffuse = [1, -0.5, 0]\n"));
+    assert_error(&message, "7:15", &["diffuse[1]", "must be ≥ 0", "found -0.5"]);
     let message = error(&format!("{CAMERA}[materials.red]\nspecular = [-1, 0, 0]\n"));
     assert_error(&message, "7:13", &["specular[0] must be ≥ 0", "found -1"]);
     let message = error(&format!("{CAMERA}[materials.red]\nshininess = -2\n"));
     assert_error(&message, "7:13", &["shininess must be ≥ 0, found -2"]);
     let message = error(&format!("{CAMERA}[background]\ncolor = [0, 0, -0.1]\n"));
     assert_error(&message, "7:16", &["color[2] must be ≥ 0", "found -0.1"]);
-    let light = |extra: &str| {
-        format!("{CAMERA}[[light]]\nkind = \"point\"\nposition = [0, 0, 0]\n{extra}\n")
-    };
+    let light = |extra: &str| format!("{CAMERA}[[light]]\nkind = \"point\"\nposition = [0, 0, 0]\n{extra}\n");
     let message = error(&light("color = [1, 1, 1]\nfalloff = 0"));
     assert_error(
         &message,
@@ -128,11 +85,7 @@ fn physically_meaningless_numbers_are_rejected() {
     let message = error(&light("color = [1, -1, 1]\nfalloff = 1"));
     assert_error(&message, "9:13", &["color[1] must be ≥ 0", "found -1"]);
     let message = error(&light("falloff = 1"));
-    assert_error(
-        &message,
-        "6:1",
-        &["point light is missing required key `color`"],
-    );
+    assert_error(&message, "6:1", &["point light is missing required key `color`"]);
 }
 
 #[test]
@@ -195,31 +148,19 @@ fn degenerate_directions_are_rejected() {
     let message = error(&format!(
         "{CAMERA}[[light]]\nkind = \"directional\"\ndirection = [0, 0, 0]\ncolor = [1, 1, 1]\n"
     ));
-    assert_error(
-        &message,
-        "8:13",
-        &["direction must have a nonzero, finite length"],
-    );
+    assert_error(&message, "8:13", &["direction must have a nonzero, finite length"]);
 }
 
 #[test]
 fn ranges_and_tolerances_are_checked() {
     let message = error(&format!("[render]\ndepth_range = [18, 8]\n{CAMERA}"));
-    assert_error(
-        &message,
-        "2:15",
-        &["depth_range must have min < max, found [18, 8]"],
-    );
+    assert_error(&message, "2:15", &["depth_range must have min < max, found [18, 8]"]);
     let message = error(&format!("[render]\ndepth_range = [8, 8]\n{CAMERA}"));
     assert_error(&message, "2:15", &["depth_range must have min < max"]);
     let message = error(&format!("[tolerance]\npixel = -0.01\n{CAMERA}"));
     assert_error(&message, "2:9", &["pixel must be ≥ 0, found -0.01"]);
     let message = error(&format!("[tolerance]\nfail_fraction = 1.5\n{CAMERA}"));
-    assert_error(
-        &message,
-        "2:17",
-        &["fail_fraction must be between 0 and 1, found 1.5"],
-    );
+    assert_error(&message, "2:17", &["fail_fraction must be between 0 and 1, found 1.5"]);
     let message = error(&format!("[tolerance]\nmax = -1\n{CAMERA}"));
     assert_error(&message, "2:7", &["max must be ≥ 0, found -1"]);
 }

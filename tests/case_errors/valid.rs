@@ -1,8 +1,7 @@
 //! A full case parses to exactly the expected values, and omitted settings get their defaults.
 
 use goldray::case::{
-    BackgroundSpec, CameraSpec, LightSpec, LoadOptions, MaterialSpec, ShapeSpec, Tolerance,
-    TransformOp, load,
+    BackgroundSpec, CameraSpec, LightSpec, LoadOptions, MaterialSpec, ShapeSpec, Tolerance, TransformOp, load,
 };
 use goldray::film::Tonemap;
 use goldray::options::{Filter, Profile};
@@ -93,11 +92,7 @@ objects = [
 #[test]
 fn a_full_case_parses_to_the_expected_values() {
     let dir = tempfile::tempdir().unwrap();
-    let obj = write(
-        dir.path(),
-        "models/tri.obj",
-        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
-    );
+    let obj = write(dir.path(), "models/tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
     for face in ["left", "right", "up", "down", "front", "back"] {
         write(dir.path(), &format!("tex/church/{face}.png"), "");
     }
@@ -111,10 +106,7 @@ fn a_full_case_parses_to_the_expected_values() {
         Some("every kind of object, light and transform op")
     );
     let r = &case.render;
-    assert_eq!(
-        (r.width, r.height, r.bounces, r.samples, r.seed),
-        (320, 240, 3, 16, 7)
-    );
+    assert_eq!((r.width, r.height, r.bounces, r.samples, r.seed), (320, 240, 3, 16, 7));
     assert!(r.shadows && r.normals);
     assert_eq!(r.filter, Filter::Gaussian);
     assert_eq!(r.depth_range, Some((8.0, 18.0)));
@@ -214,15 +206,7 @@ fn a_full_case_parses_to_the_expected_values() {
     );
     assert_eq!(plane.material, None);
     let mut matrix = [0.0; 16];
-    for (i, v) in [
-        (0, 1.0),
-        (3, 4.0),
-        (5, 1.0),
-        (7, 5.0),
-        (10, 1.0),
-        (11, 6.0),
-        (15, 1.0),
-    ] {
+    for (i, v) in [(0, 1.0), (3, 4.0), (5, 1.0), (7, 5.0), (10, 1.0), (11, 6.0), (15, 1.0)] {
         matrix[i] = v;
     }
     assert_eq!(
@@ -265,10 +249,7 @@ fn a_full_case_parses_to_the_expected_values() {
         }
     );
     assert_eq!(objects[0].material, None, "inherits from the group");
-    assert_eq!(
-        (objects[0].location.line, objects[0].location.column),
-        (75, 3)
-    );
+    assert_eq!((objects[0].location.line, objects[0].location.column), (75, 3));
     assert_eq!(objects[1].material, Some(1));
     let ShapeSpec::Group { objects: inner } = &objects[1].shape else {
         panic!("not a group")
@@ -287,10 +268,7 @@ fn a_full_case_parses_to_the_expected_values() {
 fn a_minimal_case_gets_every_default() {
     let case = try_parse(CAMERA).unwrap();
     let r = &case.render;
-    assert_eq!(
-        (r.width, r.height, r.bounces, r.samples, r.seed),
-        (200, 200, 0, 1, 0)
-    );
+    assert_eq!((r.width, r.height, r.bounces, r.samples, r.seed), (200, 200, 0, 1, 0));
     assert!(!r.shadows && !r.normals);
     assert_eq!(
         (r.filter, r.profile, r.tonemap),

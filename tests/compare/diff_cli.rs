@@ -52,11 +52,7 @@ impl Files {
             ("wider", render(&wider)),
         ] {
             write_exr(&root.join(format!("{name}.exr")), &film).expect("EXR written");
-            write_png(
-                &root.join(format!("{name}.png")),
-                &color_image(&film, Tonemap::Srgb),
-            )
-            .expect("PNG written");
+            write_png(&root.join(format!("{name}.png")), &color_image(&film, Tonemap::Srgb)).expect("PNG written");
         }
         Files { _dir: dir, root }
     }
@@ -129,35 +125,18 @@ fn diff_writes_a_heatmap_and_json_on_request() {
     let heatmap = files.path("heat.png");
     let output = goldray_diff(
         &[&files.path("golden.exr"), &files.path("unshadowed.exr")],
-        &[
-            "--json",
-            "--diff-image",
-            heatmap.to_str().expect("a UTF-8 path"),
-        ],
+        &["--json", "--diff-image", heatmap.to_str().expect("a UTF-8 path")],
     );
     assert_eq!(exit_code(&output), 2);
     let report: serde_json::Value = serde_json::from_str(&stdout(&output)).expect("JSON on stdout");
     assert_eq!(report["verdict"], "fail");
     assert_eq!(report["exit_code"], 2);
     assert_eq!(report["breaches"][0]["limit"], "fail_fraction");
-    assert!(
-        report["metrics"]["rmse"]
-            .as_f64()
-            .is_some_and(|rmse| rmse > 0.002)
-    );
-    assert!(
-        report["metrics"]["flip"]
-            .as_f64()
-            .is_some_and(|flip| flip > 0.0)
-    );
-    let picture = image::open(&heatmap)
-        .expect("the heatmap is a PNG")
-        .into_rgb8();
+    assert!(report["metrics"]["rmse"].as_f64().is_some_and(|rmse| rmse > 0.002));
+    assert!(report["metrics"]["flip"].as_f64().is_some_and(|flip| flip > 0.0));
+    let picture = image::open(&heatmap).expect("the heatmap is a PNG").into_rgb8();
     assert_eq!(picture.dimensions(), (200, 200));
-    assert!(
-        picture.pixels().any(|p| p.0 == FAILING),
-        "failing pixels are marked"
-    );
+    assert!(picture.pixels().any(|p| p.0 == FAILING), "failing pixels are marked");
 }
 
 #[test]
@@ -175,13 +154,8 @@ fn diff_refuses_a_threshold_that_would_pass_everything() {
 fn diff_reports_an_exr_without_depth_and_normals_as_a_channel_mismatch() {
     let files = Files::new();
     let colour_only = files.path("colour_only.exr");
-    exr::prelude::write_rgb_file(&colour_only, 200, 200, |_, _| (0.0_f32, 0.0_f32, 0.0_f32))
-        .expect("EXR written");
+    exr::prelude::write_rgb_file(&colour_only, 200, 200, |_, _| (0.0_f32, 0.0_f32, 0.0_f32)).expect("EXR written");
     let output = goldray_diff(&[&files.path("golden.exr"), &colour_only], &[]);
     assert_eq!(exit_code(&output), 3, "{}", stdout(&output));
-    assert!(
-        stdout(&output).contains("channels differ"),
-        "{}",
-        stdout(&output)
-    );
+    assert!(stdout(&output).contains("channels differ"), "{}", stdout(&output));
 }

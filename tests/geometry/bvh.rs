@@ -116,11 +116,7 @@ fn coinciding_centroids() {
             [v, -v, w]
         })
         .collect();
-    assert!(
-        bounds_of(&triangles)
-            .iter()
-            .all(|b| b.centroid() == Vec3::ZERO)
-    );
+    assert!(bounds_of(&triangles).iter().all(|b| b.centroid() == Vec3::ZERO));
     let bvh = Bvh::build(&bounds_of(&triangles));
     assert!(bvh.leaf_count() >= 1500 / 4);
     assert!(check_against_brute_force(&triangles, &mut rng, 300) > 100);
@@ -157,19 +153,11 @@ fn tree_shape_is_sane() {
         nodes < leaves && 3 * nodes >= leaves - 1,
         "a tree of two to four children per node: {nodes} nodes, {leaves} leaves"
     );
-    assert!(
-        bvh.leaf_count() >= 20_000 / 4,
-        "leaves hold at most 4 primitives"
-    );
+    assert!(bvh.leaf_count() >= 20_000 / 4, "leaves hold at most 4 primitives");
     let mut order = bvh.prim_indices().to_vec();
     order.sort_unstable();
-    assert!(
-        order.iter().enumerate().all(|(i, &p)| p == i as u32),
-        "a permutation"
-    );
-    let union = bounds_of(&triangles)
-        .into_iter()
-        .fold(Aabb::EMPTY, Aabb::union);
+    assert!(order.iter().enumerate().all(|(i, &p)| p == i as u32), "a permutation");
+    let union = bounds_of(&triangles).into_iter().fold(Aabb::EMPTY, Aabb::union);
     assert_eq!(bvh.bounds(), union);
 }
 
@@ -178,19 +166,10 @@ fn build_is_identical_for_any_thread_count() {
     let mut rng = Rng::new(6);
     let bounds = bounds_of(&random_triangles(&mut rng, 60_000, 100.0));
     let build_with = |threads: usize| {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap();
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         pool.install(|| Bvh::build(&bounds))
     };
     let single = build_with(1);
-    assert!(
-        single == build_with(2),
-        "1 and 2 threads built different trees"
-    );
-    assert!(
-        single == build_with(3),
-        "1 and 3 threads built different trees"
-    );
+    assert!(single == build_with(2), "1 and 2 threads built different trees");
+    assert!(single == build_with(3), "1 and 3 threads built different trees");
 }

@@ -23,15 +23,8 @@ fn blob_is_closed_and_consistently_wound_outwards() {
             }
         }
         for (&(a, b), &count) in &directed {
-            assert_eq!(
-                count, 1,
-                "edge ({a}, {b}) used {count} times in the same direction"
-            );
-            assert_eq!(
-                directed.get(&(b, a)),
-                Some(&1),
-                "edge ({a}, {b}) has no opposite"
-            );
+            assert_eq!(count, 1, "edge ({a}, {b}) used {count} times in the same direction");
+            assert_eq!(directed.get(&(b, a)), Some(&1), "edge ({a}, {b}) has no opposite");
         }
         // Outward: the surface is star-shaped around the origin, so each face normal points
         // away from it.
@@ -53,30 +46,18 @@ fn rays_from_inside_always_hit() {
     let (unit_positions, triangles) = blob(5, 3);
     assert_eq!(triangles.len(), 20_480);
     let mut rng = Rng::new(17);
-    for (scale, offset) in [
-        (1.0, 0.0),
-        (1e-4, 0.0),
-        (1e6, 0.0),
-        (1e-4, 1e-3),
-        (1e6, -1e7),
-    ] {
+    for (scale, offset) in [(1.0, 0.0), (1e-4, 0.0), (1e6, 0.0), (1e-4, 1e-3), (1e6, -1e7)] {
         let centre = Vec3::new(offset, -0.5 * offset, 0.25 * offset);
         let positions: Vec<Vec3> = unit_positions.iter().map(|&p| centre + p * scale).collect();
         let mesh = Mesh::new(&positions, &triangles, VertexNormals::Averaged).unwrap();
         for i in 0..20_000 {
             let inside = rng.direction() * rng.uniform(0.0, 0.95 * BLOB_MIN_RADIUS);
-            let ray = Ray::new(
-                centre + inside * scale,
-                rng.direction() * rng.uniform(0.1, 10.0),
-            );
+            let ray = Ray::new(centre + inside * scale, rng.direction() * rng.uniform(0.1, 10.0));
             let context = format!("scale {scale}, offset {offset}, ray {i}: {ray:?}");
             let hit = mesh
                 .intersect(&ray, Real::INFINITY)
                 .unwrap_or_else(|| panic!("escaped at {context}"));
-            assert!(
-                mesh.occluded(&ray, Real::INFINITY),
-                "not occluded at {context}"
-            );
+            assert!(mesh.occluded(&ray, Real::INFINITY), "not occluded at {context}");
             let surface = mesh.surface(&hit);
             assert!(
                 surface.geometric_normal.dot(ray.direction) > 0.0,

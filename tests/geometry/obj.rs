@@ -76,11 +76,7 @@ fn averaged_normals_are_the_unweighted_sum_across_groups() {
         .collect();
     let apex_expected = faces.iter().sum::<Vec3>().normalize();
     let apex = corner_normals(&mesh, Vec3::Z);
-    assert_eq!(
-        apex.len(),
-        4,
-        "the apex is shared by all four faces, in both groups"
-    );
+    assert_eq!(apex.len(), 4, "the apex is shared by all four faces, in both groups");
     assert!(
         apex.iter().all(|&n| close(n, apex_expected)),
         "{apex:?} vs {apex_expected}"
@@ -110,16 +106,9 @@ fn file_normals_are_used_when_asked_for() {
 fn faces_with_texture_coordinates_load() {
     let dir = tempfile::tempdir().unwrap();
     let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nf 1/1 2/2 3/3\nf 1/1/ 3/3 4/2\n";
-    let mesh = load(
-        &write(&dir, "textured.obj", text),
-        NormalSource::FromFileOrAveraged,
-    );
+    let mesh = load(&write(&dir, "textured.obj", text), NormalSource::FromFileOrAveraged);
     assert_eq!(mesh.triangle_count(), 2);
-    assert!(
-        corner_normals(&mesh, Vec3::ZERO)
-            .iter()
-            .all(|&n| close(n, Vec3::Z))
-    );
+    assert!(corner_normals(&mesh, Vec3::ZERO).iter().all(|&n| close(n, Vec3::Z)));
 }
 
 fn load_error(text: &str) -> (PathBuf, String) {
@@ -132,16 +121,8 @@ fn load_error(text: &str) -> (PathBuf, String) {
 #[test]
 fn malformed_files_name_the_path_and_line() {
     let cases = [
-        (
-            "v 0 0 0\nv 1 0 0\nv 0 1 zero\nf 1 2 3\n",
-            3,
-            "`zero` is not a number",
-        ),
-        (
-            "v 0 0 0\nv 1 0 0\nv 0 1 0\n# fine so far\nf 1 2 4\n",
-            5,
-            "out of range",
-        ),
+        ("v 0 0 0\nv 1 0 0\nv 0 1 zero\nf 1 2 3\n", 3, "`zero` is not a number"),
+        ("v 0 0 0\nv 1 0 0\nv 0 1 0\n# fine so far\nf 1 2 4\n", 5, "out of range"),
         ("v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n", 2, "finite"),
         ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n", 4, "at least 3"),
         ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", 4, "start at 1"),
@@ -149,14 +130,8 @@ fn malformed_files_name_the_path_and_line() {
     for (text, line, problem) in cases {
         let (path, message) = load_error(text);
         let location = format!("{}:{line}:", path.display());
-        assert!(
-            message.contains(&location),
-            "{message:?} should contain {location:?}"
-        );
-        assert!(
-            message.contains(problem),
-            "{message:?} should mention {problem:?}"
-        );
+        assert!(message.contains(&location), "{message:?} should contain {location:?}");
+        assert!(message.contains(problem), "{message:?} should mention {problem:?}");
     }
 }
 
@@ -175,9 +150,7 @@ fn a_missing_file_is_named() {
     let error = Mesh::load_obj(path, NormalSource::Averaged).expect_err("must not load");
     assert!(matches!(error, MeshError::Read { .. }));
     assert!(
-        error
-            .to_string()
-            .contains("/nonexistent/goldray/missing.obj"),
+        error.to_string().contains("/nonexistent/goldray/missing.obj"),
         "{error}"
     );
 }
@@ -218,21 +191,13 @@ fn course_meshes_load() {
             let target = (a + b + c) / 3.0;
             let ray = ray_through(target + rng.direction() * radius, target);
             let hit = mesh.intersect(&ray, Real::INFINITY);
-            assert!(
-                hit.is_some_and(|h| h.t <= 1.0 + 1e-4),
-                "{}: {ray:?}",
-                path.display()
-            );
+            assert!(hit.is_some_and(|h| h.t <= 1.0 + 1e-4), "{}: {ray:?}", path.display());
         }
     }
 }
 
 fn load_text(text: &str) -> Result<Mesh, MeshError> {
-    Mesh::from_obj_text(
-        text,
-        Path::new("test.obj"),
-        NormalSource::FromFileOrAveraged,
-    )
+    Mesh::from_obj_text(text, Path::new("test.obj"), NormalSource::FromFileOrAveraged)
 }
 
 /// The line number of the load error, which must be a malformed-content error.
@@ -245,8 +210,7 @@ fn problem_line(text: &str) -> usize {
 
 #[test]
 fn accepts_relative_indices_comments_quads_and_crlf() {
-    let text =
-        "# square\r\nv 0 0 0\r\nv 1 0 0 # corner\r\nv 1 1 0\r\nv 0 1 0 1\r\nf -4 -3 -2 -1\r\n";
+    let text = "# square\r\nv 0 0 0\r\nv 1 0 0 # corner\r\nv 1 1 0\r\nv 0 1 0 1\r\nf -4 -3 -2 -1\r\n";
     assert_eq!(load_text(text).unwrap().triangle_count(), 2);
 }
 
@@ -267,10 +231,7 @@ fn reports_the_offending_line() {
 
 #[test]
 fn no_faces_is_an_error() {
-    assert!(matches!(
-        load_text("v 0 0 0\n"),
-        Err(MeshError::NoFaces { .. })
-    ));
+    assert!(matches!(load_text("v 0 0 0\n"), Err(MeshError::NoFaces { .. })));
     assert!(matches!(load_text(""), Err(MeshError::NoFaces { .. })));
 }
 

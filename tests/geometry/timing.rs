@@ -16,11 +16,7 @@ use super::Rng;
 fn large_blob_timings() {
     let start = Instant::now();
     let (positions, triangles) = blob(8, 1);
-    println!(
-        "generate {} triangles: {:.2?}",
-        triangles.len(),
-        start.elapsed()
-    );
+    println!("generate {} triangles: {:.2?}", triangles.len(), start.elapsed());
 
     let start = Instant::now();
     let mesh = Mesh::new(&positions, &triangles, VertexNormals::Averaged).unwrap();
@@ -37,10 +33,7 @@ fn large_blob_timings() {
     let rays: Vec<Ray> = (0..1_000_000)
         .map(|i| {
             if i % 2 == 0 {
-                Ray::new(
-                    rng.direction() * rng.uniform(0.0, BLOB_MIN_RADIUS),
-                    rng.direction(),
-                )
+                Ray::new(rng.direction() * rng.uniform(0.0, BLOB_MIN_RADIUS), rng.direction())
             } else {
                 let origin = rng.direction() * 4.0;
                 Ray::new(origin, rng.in_box(0.8) - origin)
@@ -54,14 +47,8 @@ fn large_blob_timings() {
         .count();
     println!("1M closest-hit rays: {:.2?} ({hits} hits)", start.elapsed());
     let start = Instant::now();
-    let blocked = rays
-        .par_iter()
-        .filter(|ray| mesh.occluded(ray, Real::INFINITY))
-        .count();
-    println!(
-        "1M occlusion rays: {:.2?} ({blocked} blocked)",
-        start.elapsed()
-    );
+    let blocked = rays.par_iter().filter(|ray| mesh.occluded(ray, Real::INFINITY)).count();
+    println!("1M occlusion rays: {:.2?} ({blocked} blocked)", start.elapsed());
     assert_eq!(hits, blocked);
 
     let dir = tempfile::tempdir().unwrap();

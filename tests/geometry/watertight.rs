@@ -25,12 +25,9 @@ impl Fan {
         let count = 4 + (rng.next_u64() % 9) as usize;
         let ring = (0..count)
             .map(|i| {
-                let angle = (i as Real + rng.uniform(-0.3, 0.3)) * std::f64::consts::TAU as Real
-                    / count as Real;
+                let angle = (i as Real + rng.uniform(-0.3, 0.3)) * std::f64::consts::TAU as Real / count as Real;
                 let radius = rng.uniform(0.7, 1.3);
-                centre
-                    + (u * angle.cos() + v * angle.sin()) * radius
-                    + normal * rng.uniform(-0.02, 0.02)
+                centre + (u * angle.cos() + v * angle.sin()) * radius + normal * rng.uniform(-0.02, 0.02)
             })
             .collect();
         Fan { centre, ring }
@@ -44,9 +41,7 @@ impl Fan {
     fn hit_count(&self, ray: &Ray) -> usize {
         let triangle_ray = TriangleRay::new(ray);
         self.triangles()
-            .filter(|&[p0, p1, p2]| {
-                intersect_triangle(&triangle_ray, Real::INFINITY, p0, p1, p2).is_some()
-            })
+            .filter(|&[p0, p1, p2]| intersect_triangle(&triangle_ray, Real::INFINITY, p0, p1, p2).is_some())
             .count()
     }
 
@@ -60,14 +55,7 @@ impl Fan {
     }
 }
 
-const AXES: [Vec3; 6] = [
-    Vec3::X,
-    Vec3::Y,
-    Vec3::Z,
-    Vec3::NEG_X,
-    Vec3::NEG_Y,
-    Vec3::NEG_Z,
-];
+const AXES: [Vec3; 6] = [Vec3::X, Vec3::Y, Vec3::Z, Vec3::NEG_X, Vec3::NEG_Y, Vec3::NEG_Z];
 
 #[test]
 fn rays_through_shared_edges_and_vertices_of_a_fan_hit_it() {
@@ -81,23 +69,13 @@ fn rays_through_shared_edges_and_vertices_of_a_fan_hit_it() {
             // ray passes exactly through the target point.
             for distance in [3.0, -3.0] {
                 let ray = Ray::new(target + axis * distance, -axis * distance.signum());
-                assert!(
-                    fan.hit_count(&ray) >= 1,
-                    "axis ray {ray:?} missed fan {fan_index}"
-                );
+                assert!(fan.hit_count(&ray) >= 1, "axis ray {ray:?} missed fan {fan_index}");
             }
             for _ in 0..4 {
                 let offset = (axis + rng.in_box(0.3)) * rng.uniform(0.5, 20.0);
-                let side = if rng.next_u64().is_multiple_of(2) {
-                    1.0
-                } else {
-                    -1.0
-                };
+                let side = if rng.next_u64().is_multiple_of(2) { 1.0 } else { -1.0 };
                 let ray = ray_through(target + offset * side, target);
-                assert!(
-                    fan.hit_count(&ray) >= 1,
-                    "ray {ray:?} missed fan {fan_index}"
-                );
+                assert!(fan.hit_count(&ray) >= 1, "ray {ray:?} missed fan {fan_index}");
             }
             rays += 6;
         }
@@ -123,12 +101,7 @@ fn axis_aligned_rays_through_mesh_vertices_and_edges_hit() {
     let mut triangles = Vec::new();
     for y in 0..size {
         for x in 0..size {
-            let (a, b, c, d) = (
-                vertex(x, y),
-                vertex(x + 1, y),
-                vertex(x + 1, y + 1),
-                vertex(x, y + 1),
-            );
+            let (a, b, c, d) = (vertex(x, y), vertex(x + 1, y), vertex(x + 1, y + 1), vertex(x, y + 1));
             triangles.extend([[a, b, c], [a, c, d]]);
         }
     }
@@ -139,14 +112,8 @@ fn axis_aligned_rays_through_mesh_vertices_and_edges_hit() {
             let (x, y) = (x2 as Real * 0.5, y2 as Real * 0.5);
             for (origin_z, direction) in [(10.0, Vec3::NEG_Z), (-10.0, Vec3::Z)] {
                 let ray = Ray::new(Vec3::new(x, y, origin_z), direction);
-                assert!(
-                    mesh.intersect(&ray, Real::INFINITY).is_some(),
-                    "missed at ({x}, {y})"
-                );
-                assert!(
-                    mesh.occluded(&ray, Real::INFINITY),
-                    "not occluded at ({x}, {y})"
-                );
+                assert!(mesh.intersect(&ray, Real::INFINITY).is_some(), "missed at ({x}, {y})");
+                assert!(mesh.occluded(&ray, Real::INFINITY), "not occluded at ({x}, {y})");
                 checked += 1;
             }
         }

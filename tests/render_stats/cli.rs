@@ -10,7 +10,10 @@ use goldray::options::Filter;
 use serde_json::Value;
 
 fn goldray(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_goldray")).args(args).output().expect("the goldray binary runs")
+    Command::new(env!("CARGO_BIN_EXE_goldray"))
+        .args(args)
+        .output()
+        .expect("the goldray binary runs")
 }
 
 fn stderr(output: &Output) -> String {
@@ -26,7 +29,9 @@ fn read_json(path: &Path) -> Value {
 }
 
 fn count(json: &Value, kind: &str) -> u64 {
-    json["rays"][kind].as_u64().unwrap_or_else(|| panic!("rays.{kind} in {json}"))
+    json["rays"][kind]
+        .as_u64()
+        .unwrap_or_else(|| panic!("rays.{kind} in {json}"))
 }
 
 #[test]
@@ -36,7 +41,10 @@ fn stats_print_a_table_and_write_json_without_changing_the_exr() {
     let case = case.to_str().unwrap();
     let json_path = dir.path().join("stats.json");
     let mut exrs = Vec::new();
-    for (run, flags) in [("plain", vec![]), ("stats", vec!["--stats", "--stats-json", json_path.to_str().unwrap()])] {
+    for (run, flags) in [
+        ("plain", vec![]),
+        ("stats", vec!["--stats", "--stats-json", json_path.to_str().unwrap()]),
+    ] {
         let out = dir.path().join(run);
         let mut args = vec!["render", case, "--out", out.to_str().unwrap(), "--quiet"];
         args.extend(flags);
@@ -46,7 +54,18 @@ fn stats_print_a_table_and_write_json_without_changing_the_exr() {
         if run == "plain" {
             assert!(table.is_empty(), "nothing on stderr without --stats: {table}");
         } else {
-            for expected in ["Statistics for mirrors (200×150", "parse", "build scene", "render", "write outputs", "Mrays/s", "camera", "shadow", "reflection", "Peak resident memory"] {
+            for expected in [
+                "Statistics for mirrors (200×150",
+                "parse",
+                "build scene",
+                "render",
+                "write outputs",
+                "Mrays/s",
+                "camera",
+                "shadow",
+                "reflection",
+                "Peak resident memory",
+            ] {
                 assert!(table.contains(expected), "{expected:?} missing from\n{table}");
             }
         }
@@ -56,7 +75,10 @@ fn stats_print_a_table_and_write_json_without_changing_the_exr() {
     let json = read_json(&json_path);
     assert_eq!(json["case"], "mirrors");
     assert_eq!((count(&json, "camera"), count(&json, "aov")), (200 * 150, 0));
-    let sum: u64 = ["camera", "aov", "shadow", "reflection"].iter().map(|kind| count(&json, kind)).sum();
+    let sum: u64 = ["camera", "aov", "shadow", "reflection"]
+        .iter()
+        .map(|kind| count(&json, kind))
+        .sum();
     assert_eq!(count(&json, "total"), sum);
     assert!(count(&json, "shadow") > 0 && count(&json, "reflection") > 0);
     assert!(json["seconds"]["render"].as_f64().unwrap() > 0.0);
@@ -76,15 +98,25 @@ fn json_counts_are_the_same_on_one_and_two_threads() {
             let json = dir.path().join(format!("{threads}.json"));
             let out = dir.path().join(threads);
             let result = goldray(&[
-                "render", case.to_str().unwrap(), "--out", out.to_str().unwrap(), "--threads", threads, "--quiet",
-                "--stats-json", json.to_str().unwrap(),
+                "render",
+                case.to_str().unwrap(),
+                "--out",
+                out.to_str().unwrap(),
+                "--threads",
+                threads,
+                "--quiet",
+                "--stats-json",
+                json.to_str().unwrap(),
             ]);
             assert!(result.status.success(), "{}", stderr(&result));
             read_json(&json)
         })
         .collect();
     assert_eq!(stats[0]["rays"], stats[1]["rays"]);
-    assert_eq!((stats[0]["threads"].as_u64(), stats[1]["threads"].as_u64()), (Some(1), Some(2)));
+    assert_eq!(
+        (stats[0]["threads"].as_u64(), stats[1]["threads"].as_u64()),
+        (Some(1), Some(2))
+    );
 }
 
 /// The "done when": statistics work on every shipped case, with camera and AOV ray
@@ -103,19 +135,39 @@ fn every_shipped_case_reports_statistics() {
         let case = load(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
         let json_path = dir.path().join(format!("{}.json", case.name));
         let result = goldray(&[
-            "render", path.to_str().unwrap(), "--out", dir.path().to_str().unwrap(), "--quiet", "--stats",
-            "--stats-json", json_path.to_str().unwrap(),
+            "render",
+            path.to_str().unwrap(),
+            "--out",
+            dir.path().to_str().unwrap(),
+            "--quiet",
+            "--stats",
+            "--stats-json",
+            json_path.to_str().unwrap(),
         ]);
         assert!(result.status.success(), "{}: {}", case.name, stderr(&result));
-        assert!(stderr(&result).contains(&format!("Statistics for {}", case.name)), "{}", stderr(&result));
+        assert!(
+            stderr(&result).contains(&format!("Statistics for {}", case.name)),
+            "{}",
+            stderr(&result)
+        );
         let json = read_json(&json_path);
         let settings = &case.render;
         let pixels = u64::from(settings.width) * u64::from(settings.height);
         let subpixels = if settings.filter == Filter::Gaussian { 9 } else { 1 };
         let averaged = settings.samples > 1 || settings.filter == Filter::Gaussian;
-        assert_eq!(count(&json, "camera"), pixels * subpixels * u64::from(settings.samples), "{}", case.name);
+        assert_eq!(
+            count(&json, "camera"),
+            pixels * subpixels * u64::from(settings.samples),
+            "{}",
+            case.name
+        );
         assert_eq!(count(&json, "aov"), if averaged { pixels } else { 0 }, "{}", case.name);
-        assert_eq!(count(&json, "shadow") > 0, settings.shadows && !case.lights.is_empty(), "{}", case.name);
+        assert_eq!(
+            count(&json, "shadow") > 0,
+            settings.shadows && !case.lights.is_empty(),
+            "{}",
+            case.name
+        );
         if settings.bounces == 0 {
             assert_eq!(count(&json, "reflection"), 0, "{}", case.name);
         }
@@ -124,7 +176,11 @@ fn every_shipped_case_reports_statistics() {
             assert_eq!(bvh["primitives"], mesh["triangles"], "{}", case.name);
             // A 4-wide tree: each node holds two to four children (a lone leaf is one node's only child).
             let (nodes, leaves) = (bvh["nodes"].as_u64().unwrap(), bvh["leaves"].as_u64().unwrap());
-            assert!(nodes > 0 && nodes <= leaves && 3 * nodes + 1 >= leaves, "{}: {nodes} nodes, {leaves} leaves", case.name);
+            assert!(
+                nodes > 0 && nodes <= leaves && 3 * nodes + 1 >= leaves,
+                "{}: {nodes} nodes, {leaves} leaves",
+                case.name
+            );
         }
     }
 }
@@ -149,21 +205,48 @@ fn the_course_command_takes_the_stats_flags_too() {
     let normals = dir.path().join("normals.png");
     let run = |extra: &[&str]| {
         let mut args = vec![
-            "mit6837", "-input", scene.to_str().unwrap(), "-output", png.to_str().unwrap(), "-size", "10", "10", "-shadows",
-            "-jitter", "-stats", "-stats-json", json_path.to_str().unwrap(), "--quiet",
+            "mit6837",
+            "-input",
+            scene.to_str().unwrap(),
+            "-output",
+            png.to_str().unwrap(),
+            "-size",
+            "10",
+            "10",
+            "-shadows",
+            "-jitter",
+            "-stats",
+            "-stats-json",
+            json_path.to_str().unwrap(),
+            "--quiet",
         ];
         args.extend_from_slice(extra);
         let result = goldray(&args);
         assert!(result.status.success(), "{}", stderr(&result));
-        assert!(stderr(&result).contains("Statistics for two_lights (10×10"), "{}", stderr(&result));
+        assert!(
+            stderr(&result).contains("Statistics for two_lights (10×10"),
+            "{}",
+            stderr(&result)
+        );
         read_json(&json_path)
     };
     let json = run(&[]);
-    assert_eq!((count(&json, "camera"), count(&json, "aov")), (1600, 0), "16 jittered samples per pixel, no AOV written");
+    assert_eq!(
+        (count(&json, "camera"), count(&json, "aov")),
+        (1600, 0),
+        "16 jittered samples per pixel, no AOV written"
+    );
     let shadow = count(&json, "shadow");
-    assert!(shadow > 0 && shadow.is_multiple_of(2), "two shadow rays per hit: {shadow}");
+    assert!(
+        shadow > 0 && shadow.is_multiple_of(2),
+        "two shadow rays per hit: {shadow}"
+    );
     let json = run(&["-normals", normals.to_str().unwrap()]);
-    assert_eq!((count(&json, "camera"), count(&json, "aov")), (1600, 100), "the normals image needs the AOV rays");
+    assert_eq!(
+        (count(&json, "camera"), count(&json, "aov")),
+        (1600, 100),
+        "the normals image needs the AOV rays"
+    );
     assert_eq!(count(&json, "shadow"), shadow);
 }
 
@@ -174,8 +257,13 @@ fn an_unwritable_stats_file_is_an_error_naming_it() {
     fs::write(&blocker, b"").unwrap();
     let json_path = blocker.join("stats.json");
     let result = goldray(&[
-        "render", shipped_case("raw_matrix.toml").to_str().unwrap(), "--out", dir.path().to_str().unwrap(), "--quiet",
-        "--stats-json", json_path.to_str().unwrap(),
+        "render",
+        shipped_case("raw_matrix.toml").to_str().unwrap(),
+        "--out",
+        dir.path().to_str().unwrap(),
+        "--quiet",
+        "--stats-json",
+        json_path.to_str().unwrap(),
     ]);
     assert_eq!(result.status.code(), Some(1));
     assert!(stderr(&result).contains("stats.json"), "{}", stderr(&result));

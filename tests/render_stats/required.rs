@@ -30,7 +30,11 @@ fn no_reflection_rays_from_materials_without_a_specular_colour() {
                  [[object]]\nkind = \"plane\"\nnormal = [0, 1, 0]\noffset = -1\nmaterial = \"matte\"\n";
     let scene = format!("{TWO_POINT_LIGHTS}{SPHERE}{matte}");
     let (film, counts) = counted(&case("bounces = 5\nshadows = true", &scene));
-    assert!(hits(&film) > 50, "the sphere and the floor are shaded: {} hits", hits(&film));
+    assert!(
+        hits(&film) > 50,
+        "the sphere and the floor are shaded: {} hits",
+        hits(&film)
+    );
     assert_eq!(counts.reflection, 0, "{counts:?}");
     let mirror = "[materials.mirror]\nspecular = [1, 1, 1]\n\
                   [[object]]\nkind = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"mirror\"\n";
@@ -42,7 +46,12 @@ fn no_reflection_rays_from_materials_without_a_specular_colour() {
 /// colour is the same without it, and the film's AOVs stay all misses.
 #[test]
 fn no_aov_rays_when_no_aov_is_written() {
-    for render in ["samples = 4", "filter = \"gaussian\"", "samples = 4\nfilter = \"gaussian\"", ""] {
+    for render in [
+        "samples = 4",
+        "filter = \"gaussian\"",
+        "samples = 4\nfilter = \"gaussian\"",
+        "",
+    ] {
         let case = case(render, SPHERE);
         let scene = build_scene(&case).unwrap_or_else(|e| panic!("{e}"));
         let with = render_options(&case);
@@ -64,9 +73,21 @@ fn no_aov_rays_when_no_aov_is_written() {
 fn no_scene_bvh_for_planes_or_a_single_object() {
     let plane = |offset: i32| format!("[[object]]\nkind = \"plane\"\nnormal = [0, 1, 0]\noffset = {offset}\n");
     let sphere = |x: i32| format!("[[object]]\nkind = \"sphere\"\ncenter = [{x}, 0, 0]\nradius = 0.4\n");
-    let scene_bvh = |body: &str| build_scene(&case("", body)).unwrap_or_else(|e| panic!("{e}")).geometry.bvh().is_some();
+    let scene_bvh = |body: &str| {
+        build_scene(&case("", body))
+            .unwrap_or_else(|e| panic!("{e}"))
+            .geometry
+            .bvh()
+            .is_some()
+    };
     assert!(!scene_bvh(&(-3..3).map(plane).collect::<String>()), "planes only");
     assert!(!scene_bvh(&sphere(0)), "one sphere");
-    assert!(!scene_bvh(&format!("{}{}", sphere(0), plane(-1))), "one sphere over a plane");
-    assert!(scene_bvh(&(-3..3).map(sphere).collect::<String>()), "six spheres do get a tree");
+    assert!(
+        !scene_bvh(&format!("{}{}", sphere(0), plane(-1))),
+        "one sphere over a plane"
+    );
+    assert!(
+        scene_bvh(&(-3..3).map(sphere).collect::<String>()),
+        "six spheres do get a tree"
+    );
 }

@@ -81,10 +81,8 @@ impl Parser<'_> {
                 _ => return Err(self.unknown(token, "light", KINDS, "lights")),
             });
         }
-        self.lex.expect(
-            "}",
-            &format!("closing Lights after its {count} (numLights) lights"),
-        )?;
+        self.lex
+            .expect("}", &format!("closing Lights after its {count} (numLights) lights"))?;
         Ok(lights)
     }
 

@@ -134,11 +134,10 @@ impl<'a> Lexer<'a> {
                 self.pos += word.len();
                 Ok(token)
             }
-            Some(token) if token.text.len() > 1 && token.text.contains(['{', '}']) => Err(self
-                .unexpected(&format!(
-                    "`{word}` {context} (braces need whitespace around them, except a `}}` \
+            Some(token) if token.text.len() > 1 && token.text.contains(['{', '}']) => Err(self.unexpected(&format!(
+                "`{word}` {context} (braces need whitespace around them, except a `}}` \
                      right after a number)"
-                ))),
+            ))),
             _ => Err(self.unexpected(&format!("`{word}` {context}"))),
         }
     }
@@ -295,11 +294,7 @@ mod tests {
 
     #[test]
     fn counts_are_whole_and_non_negative() {
-        let count = |text: &str| {
-            Lexer::new(Path::new("s.txt"), text)
-                .count("numObjects")
-                .map(|(n, _)| n)
-        };
+        let count = |text: &str| Lexer::new(Path::new("s.txt"), text).count("numObjects").map(|(n, _)| n);
         assert_eq!(count("3}").unwrap(), 3);
         assert!(count("2.5").is_err());
         assert!(count("-1").is_err());

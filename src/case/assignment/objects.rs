@@ -58,10 +58,8 @@ impl<'a> Parser<'a> {
                 _ => objects.push(self.object(token, "object", GROUP_WORDS, "objects")?),
             }
         }
-        self.lex.expect(
-            "}",
-            &format!("closing Group after its {count} (numObjects) objects"),
-        )?;
+        self.lex
+            .expect("}", &format!("closing Group after its {count} (numObjects) objects"))?;
         Ok(objects)
     }
 
@@ -89,13 +87,7 @@ impl<'a> Parser<'a> {
 
     /// The object whose keyword is `token`; primitives take the current material, as the
     /// course's parser gives each primitive the material current when it is read.
-    fn object(
-        &mut self,
-        token: Token<'a>,
-        what: &str,
-        valid: &[&str],
-        noun: &str,
-    ) -> Result<ObjectSpec> {
+    fn object(&mut self, token: Token<'a>, what: &str, valid: &[&str], noun: &str) -> Result<ObjectSpec> {
         let shape = match token.text {
             "Group" => ShapeSpec::Group {
                 objects: self.nested(token, Self::group)?,
@@ -181,11 +173,7 @@ impl<'a> Parser<'a> {
         let written = self.lex.word_for("a file name after `obj_file`")?;
         let obj = self.dir.join(written.text);
         if let Some(problem) = file_problem(&obj) {
-            let message = format!(
-                "`obj_file {}` resolves to {}, {problem}",
-                written.text,
-                obj.display()
-            );
+            let message = format!("`obj_file {}` resolves to {}, {problem}", written.text, obj.display());
             return Err(self.lex.error_at(written.start, message));
         }
         self.lex.expect("}", "closing TriangleMesh")?;
@@ -198,17 +186,11 @@ impl<'a> Parser<'a> {
         self.lex.expect("{", "after `Transform`")?;
         let mut ops = Vec::new();
         let mut object = loop {
-            let token = self
-                .lex
-                .word_for("a transform op or the object it transforms")?;
+            let token = self.lex.word_for("a transform op or the object it transforms")?;
             let op = match token.text {
                 "Scale" => TransformOp::Scale(self.lex.vec3("3 numbers after `Scale`")?.value),
-                "UniformScale" => {
-                    TransformOp::UniformScale(self.lex.number("a number after `UniformScale`")?.0)
-                }
-                "Translate" => {
-                    TransformOp::Translate(self.lex.vec3("3 numbers after `Translate`")?.value)
-                }
+                "UniformScale" => TransformOp::UniformScale(self.lex.number("a number after `UniformScale`")?.0),
+                "Translate" => TransformOp::Translate(self.lex.vec3("3 numbers after `Translate`")?.value),
                 "XRotate" => TransformOp::RotateX(self.degrees("XRotate")?),
                 "YRotate" => TransformOp::RotateY(self.degrees("YRotate")?),
                 "ZRotate" => TransformOp::RotateZ(self.degrees("ZRotate")?),
@@ -224,12 +206,7 @@ impl<'a> Parser<'a> {
                     return Err(self.lex.error_at(token.start, message));
                 }
                 _ => {
-                    break self.object(
-                        token,
-                        "transform op or object",
-                        TRANSFORM_WORDS,
-                        "ops and objects",
-                    )?;
+                    break self.object(token, "transform op or object", TRANSFORM_WORDS, "ops and objects")?;
                 }
             };
             ops.push(op);
@@ -248,10 +225,7 @@ impl<'a> Parser<'a> {
     }
 
     fn degrees(&mut self, op: &str) -> Result<f64> {
-        Ok(self
-            .lex
-            .number(&format!("a number of degrees after `{op}`"))?
-            .0)
+        Ok(self.lex.number(&format!("a number of degrees after `{op}`"))?.0)
     }
 
     fn rotate(&mut self) -> Result<TransformOp> {
@@ -261,9 +235,7 @@ impl<'a> Parser<'a> {
             let rule = "must have a nonzero, finite length";
             return Err(self.invalid_vec(&axis, "the rotation axis", rule));
         }
-        let (degrees, _) = self
-            .lex
-            .number("a number of degrees after the axis of `Rotate`")?;
+        let (degrees, _) = self.lex.number("a number of degrees after the axis of `Rotate`")?;
         self.lex.expect("}", "closing Rotate { axis degrees }")?;
         Ok(TransformOp::Rotate {
             axis: axis.value,
@@ -277,14 +249,10 @@ impl<'a> Parser<'a> {
         let mut m = [0.0; 16];
         for column in 0..4 {
             for row in 0..4 {
-                m[row * 4 + column] = self
-                    .lex
-                    .number("16 numbers (column by column) after `Matrix4f {`")?
-                    .0;
+                m[row * 4 + column] = self.lex.number("16 numbers (column by column) after `Matrix4f {`")?.0;
             }
         }
-        self.lex
-            .expect("}", "closing Matrix4f after its 16 numbers")?;
+        self.lex.expect("}", "closing Matrix4f after its 16 numbers")?;
         Ok(TransformOp::Matrix(m))
     }
 }
