@@ -6,6 +6,7 @@
 //! single-precision ones, the default, are also reachable at the crate root.
 
 pub mod assignment_outputs;
+pub mod atomic_write;
 pub mod build_error;
 pub mod case;
 pub mod compare;

@@ -3,13 +3,15 @@
 
 use serde::Deserialize;
 
+mod error;
 mod exr;
 mod output;
 mod png;
 
 pub use self::exr::{decode_exr, encode_exr, read_exr, write_exr};
-pub use self::output::{OutputError, OutputOptions, encode_png, write_file_atomic, write_outputs, write_png};
-pub use self::png::{color_image, depth_image, normals_image};
+pub use self::error::OutputError;
+pub use self::output::{OutputOptions, write_outputs};
+pub use self::png::{color_image, depth_image, encode_png, normals_image, write_png};
 
 /// A rendered frame. Pixels are row-major with row 0 at the top of the picture.
 ///

@@ -23,8 +23,9 @@ use super::error::GradeError;
 use super::rubric::{Output, Rubric};
 use crate::case::{Case, ObjectSpec, ShapeSpec};
 use crate::compare::Image;
+use crate::atomic_write::write_file_atomic;
 use crate::film::{
-    Film, color_image, decode_exr, depth_image, encode_exr, normals_image, write_file_atomic, write_png,
+    Film, color_image, decode_exr, depth_image, encode_exr, normals_image, write_png,
 };
 use crate::pipeline::render_case;
 

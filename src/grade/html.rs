@@ -13,7 +13,8 @@ use super::golden::GOLDEN_DIR;
 use super::report::{ClassReport, format_points};
 use super::score::{ImageResult, Outcome, StudentResult, percent};
 use crate::compare::Metrics;
-use crate::film::{OutputError, write_file_atomic};
+use crate::atomic_write::write_file_atomic;
+use crate::film::OutputError;
 
 const STYLE: &str = r#"
 body{font:14px/1.4 system-ui,sans-serif;margin:1.5em;color:#222;background:#fafafa}

@@ -9,7 +9,8 @@ use serde::Serialize;
 use super::golden::GoldenRender;
 use super::rubric::{ImageSpec, Rubric};
 use super::score::StudentResult;
-use crate::film::{OutputError, write_file_atomic};
+use crate::atomic_write::write_file_atomic;
+use crate::film::OutputError;
 
 /// Everything one grading run found; `grades.json` is this, serialised.
 #[derive(Clone, Debug, Serialize)]
@@ -50,7 +51,8 @@ pub fn write_data(report: &ClassReport, out: &Path) -> Result<(), OutputError> {
     // Serialising plain data to a string cannot fail; infinite numbers (the PSNR of identical
     // pictures) become null.
     let json = serde_json::to_string_pretty(report).unwrap_or_else(|e| format!("{{\"error\": {:?}}}", e.to_string()));
-    write_file_atomic(&out.join("grades.json"), (json + "\n").as_bytes())
+    write_file_atomic(&out.join("grades.json"), (json + "\n").as_bytes())?;
+    Ok(())
 }
 
 /// One row per student: the folder name, the points of each image in rubric order, the total.

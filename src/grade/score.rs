@@ -10,7 +10,8 @@ use super::rubric::{ImageSpec, Rule};
 use super::submission::{Folder, read_png};
 use crate::case::Tolerance;
 use crate::compare::{Image, Metrics, compare, diff_heatmap};
-use crate::film::{OutputError, encode_png, write_file_atomic, write_png};
+use crate::atomic_write::write_file_atomic;
+use crate::film::{OutputError, encode_png, write_png};
 
 /// The verdict on one expected file. Only the first three come from a comparison; the others say
 /// why there was nothing to compare, and score nothing.

@@ -18,7 +18,7 @@ use std::time::Duration;
 use serde::{Serialize, Serializer};
 
 use crate::case::Case;
-use crate::film::{OutputError, write_file_atomic};
+use crate::atomic_write::{AtomicWriteError, write_file_atomic};
 
 /// Why `--stats-json` could not be written.
 #[derive(Debug, thiserror::Error)]
@@ -27,7 +27,7 @@ pub enum StatsError {
     Json(#[from] serde_json::Error),
     /// The path is named because the underlying error may only name a directory on the way.
     #[error("statistics {}: {source}", path.display())]
-    Write { path: PathBuf, source: OutputError },
+    Write { path: PathBuf, source: AtomicWriteError },
 }
 
 /// A BVH's size and what building it took.

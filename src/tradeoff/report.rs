@@ -16,7 +16,7 @@ use super::error::TradeoffError;
 use super::measure::Measurement;
 use super::pareto::SAME_ERROR;
 use super::plot::{SOFTWARE, is_our_png, plot_png};
-use crate::film::write_file_atomic;
+use crate::atomic_write::write_file_atomic;
 use crate::stats::grouped;
 
 pub const CSV_FILE: &str = "tradeoff.csv";
