@@ -33,10 +33,10 @@ use goldray::options::{Filter, Profile, RenderOptions, Spawn};
 use goldray::pipeline::{render_case, render_options};
 use goldray::progress::Progress;
 use goldray::real::{Color, Real, Vec3};
+use goldray::render::{render, render_counting_rays};
 use goldray::scene::camera::Camera;
 use goldray::scene::light::Light;
 use goldray::scene::material::Material;
-use goldray::render::{render, render_counting_rays};
 use goldray::scene::{Aggregate, Background, Object, Scene, Shape, build_scene};
 use rayon::prelude::*;
 

@@ -215,7 +215,9 @@ fn run(cli: Cli) -> Result<ExitCode, String> {
                 Some(path) if path.exists() && !force => {
                     Err(format!("{} exists; pass --force to replace it", path.display()))
                 }
-                Some(path) => goldray::atomic_write::write_file_atomic(&path, text.as_bytes()).map_err(|e| e.to_string()),
+                Some(path) => {
+                    goldray::atomic_write::write_file_atomic(&path, text.as_bytes()).map_err(|e| e.to_string())
+                }
                 None => std::io::stdout()
                     .write_all(text.as_bytes())
                     .map_err(|e| format!("cannot write to standard output: {e}")),

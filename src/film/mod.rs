@@ -8,8 +8,8 @@ mod exr;
 mod output;
 mod png;
 
-pub use self::exr::{decode_exr, encode_exr, read_exr, write_exr};
 pub use self::error::OutputError;
+pub use self::exr::{decode_exr, encode_exr, read_exr, write_exr};
 pub use self::output::{OutputOptions, write_outputs};
 pub use self::png::{color_image, depth_image, encode_png, normals_image, write_png};
 

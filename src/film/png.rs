@@ -102,7 +102,6 @@ pub(super) fn encode_png_named(image: &RgbImage, file: &str) -> Result<Vec<u8>, 
     Ok(bytes.into_inner())
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::*;

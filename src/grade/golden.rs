@@ -21,12 +21,10 @@ use serde::Serialize;
 
 use super::error::GradeError;
 use super::rubric::{Output, Rubric};
+use crate::atomic_write::write_file_atomic;
 use crate::case::{Case, ObjectSpec, ShapeSpec};
 use crate::compare::Image;
-use crate::atomic_write::write_file_atomic;
-use crate::film::{
-    Film, color_image, decode_exr, depth_image, encode_exr, normals_image, write_png,
-};
+use crate::film::{Film, color_image, decode_exr, depth_image, encode_exr, normals_image, write_png};
 use crate::pipeline::render_case;
 
 /// Where the report keeps the golden PNGs, relative to the report directory.

@@ -12,8 +12,8 @@ use std::path::Path;
 use super::golden::GOLDEN_DIR;
 use super::report::{ClassReport, format_points};
 use super::score::{ImageResult, Outcome, StudentResult, percent};
-use crate::compare::Metrics;
 use crate::atomic_write::write_file_atomic;
+use crate::compare::Metrics;
 use crate::film::OutputError;
 
 const STYLE: &str = r#"

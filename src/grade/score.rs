@@ -8,9 +8,9 @@ use serde::Serialize;
 use super::golden::GOLDEN_DIR;
 use super::rubric::{ImageSpec, Rule};
 use super::submission::{Folder, read_png};
+use crate::atomic_write::write_file_atomic;
 use crate::case::Tolerance;
 use crate::compare::{Image, Metrics, compare, diff_heatmap};
-use crate::atomic_write::write_file_atomic;
 use crate::film::{OutputError, encode_png, write_png};
 
 /// The verdict on one expected file. Only the first three come from a comparison; the others say

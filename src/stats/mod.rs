@@ -17,8 +17,8 @@ use std::time::Duration;
 
 use serde::{Serialize, Serializer};
 
-use crate::case::Case;
 use crate::atomic_write::{AtomicWriteError, write_file_atomic};
+use crate::case::Case;
 
 /// Why `--stats-json` could not be written.
 #[derive(Debug, thiserror::Error)]

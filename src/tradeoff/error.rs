@@ -5,9 +5,9 @@
 use std::io;
 use std::path::PathBuf;
 
+use crate::atomic_write::AtomicWriteError;
 use crate::build_error::BuildError;
 use crate::case::CaseError;
-use crate::atomic_write::AtomicWriteError;
 
 #[derive(Debug, thiserror::Error)]
 pub enum TradeoffError {
