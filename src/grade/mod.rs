@@ -22,6 +22,7 @@
 mod error;
 mod golden;
 mod html;
+mod outcome;
 mod report;
 mod rubric;
 mod score;
@@ -37,9 +38,10 @@ use rayon::prelude::*;
 
 pub use error::GradeError;
 pub use golden::{GoldenRender, Goldens, prepare_goldens};
+pub use outcome::Outcome;
 pub use report::{ClassReport, RubricSummary};
 pub use rubric::{ImageSpec, Output, RenderSource, Rubric, Rule, load_rubric, parse_rubric};
-pub use score::{ImageResult, Outcome, StudentResult, Submission, grade_image, judge};
+pub use score::{ImageResult, StudentResult, Submission, grade_image, judge};
 
 /// `goldray grade`'s command line.
 #[derive(Clone, Debug, clap::Args)]

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use super::error::TradeoffError;
-use super::sweep::Setting;
+use super::setting::Setting;
 use crate::case::{Case, Tolerance};
 use crate::compare::{Image, compare};
 use crate::film::Film;

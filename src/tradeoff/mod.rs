@@ -28,6 +28,7 @@ mod measure;
 mod pareto;
 mod plot;
 mod report;
+mod setting;
 mod sweep;
 
 use std::io::IsTerminal;
@@ -41,7 +42,8 @@ pub use measure::{Errors, Measurement, Metric, Reference};
 pub use pareto::{cheapest_within, pareto_front};
 pub use plot::{HEIGHT as PLOT_HEIGHT, WIDTH as PLOT_WIDTH};
 pub use report::{CSV_COLUMNS, CSV_FILE, MARKDOWN_FILE, PLOT_FILE, csv, markdown};
-pub use sweep::{BounceOutcome, Setting, SweepPlan};
+pub use setting::Setting;
+pub use sweep::{BounceOutcome, SweepPlan};
 
 use crate::case::{self, Case, LoadOptions};
 use report::{check_replaceable, significant, write_report};
