@@ -11,7 +11,8 @@ use std::path::Path;
 
 use super::golden::GOLDEN_DIR;
 use super::report::{ClassReport, format_points};
-use super::score::{ImageResult, Outcome, StudentResult, percent};
+use super::outcome::Outcome;
+use super::score::{ImageResult, StudentResult, percent};
 use crate::atomic_write::write_file_atomic;
 use crate::compare::Metrics;
 use crate::film::OutputError;
