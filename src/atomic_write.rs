@@ -31,11 +31,61 @@ pub enum AtomicWriteError {
 /// and a crash leaves the old file intact: the bytes go to a synced temporary file beside `path`,
 /// which is then renamed over it. Creates the parent directory if missing.
 pub fn write_file_atomic(path: &Path, bytes: &[u8]) -> Result<(), AtomicWriteError> {
-    let dir = match path.parent() {
+    write_files_atomic(parent_folder(path), &[(path, bytes)])
+}
+
+/// Checks, before any work is spent on it, that `path` could be written: it is not a folder, and
+/// its folder (or, when that is missing, the nearest existing folder above it, since writing
+/// creates missing folders) accepts a new file. The error names `path`, never a temporary file.
+pub fn check_writable(path: &Path) -> Result<(), AtomicWriteError> {
+    if path.is_dir() {
+        return Err(AtomicWriteError::Write {
+            path: path.to_path_buf(),
+            source: io::ErrorKind::IsADirectory.into(),
+        });
+    }
+    check_folder_writable(parent_folder(path)).map_err(|source| AtomicWriteError::Write {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// [`check_writable`] for a folder that files will be written into (created if missing).
+pub fn check_writable_folder(folder: &Path) -> Result<(), AtomicWriteError> {
+    check_folder_writable(folder).map_err(|source| AtomicWriteError::Write {
+        path: folder.to_path_buf(),
+        source,
+    })
+}
+
+fn check_folder_writable(folder: &Path) -> io::Result<()> {
+    let mut existing = folder;
+    while fs::symlink_metadata(existing).is_err() {
+        match existing.parent() {
+            Some(parent) if !parent.as_os_str().is_empty() => existing = parent,
+            _ => {
+                existing = Path::new(".");
+                break;
+            }
+        }
+    }
+    if !existing.is_dir() {
+        return Err(io::Error::new(
+            io::ErrorKind::NotADirectory,
+            format!("{} is not a folder", existing.display()),
+        ));
+    }
+    tempfile::Builder::new()
+        .prefix(".goldray-check-")
+        .tempfile_in(existing)
+        .map(drop)
+}
+
+fn parent_folder(path: &Path) -> &Path {
+    match path.parent() {
         Some(parent) if !parent.as_os_str().is_empty() => parent,
         _ => Path::new("."),
-    };
-    write_files_atomic(dir, &[(path, bytes)])
+    }
 }
 
 /// A target that has been replaced, and how to undo that.
@@ -137,6 +187,30 @@ fn write_synced(path: &Path, bytes: &[u8]) -> io::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn writability_is_checked_at_the_nearest_existing_folder_and_names_the_path_given() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        assert!(check_writable(&dir.path().join("a.png")).is_ok());
+        assert!(check_writable(&dir.path().join("new/deeper/a.png")).is_ok());
+        assert!(check_writable_folder(&dir.path().join("new")).is_ok());
+        let error = check_writable(dir.path()).unwrap_err().to_string();
+        assert!(
+            error.starts_with(&format!("cannot write {}", dir.path().display())),
+            "{error}"
+        );
+        fs::write(dir.path().join("file"), b"x").expect("write");
+        let error = check_writable(&dir.path().join("file/a.png")).unwrap_err().to_string();
+        assert!(
+            error.contains("file/a.png") && error.contains("is not a folder"),
+            "{error}"
+        );
+        assert_eq!(
+            fs::read_dir(dir.path()).expect("list").count(),
+            1,
+            "a check leaves nothing behind"
+        );
+    }
 
     #[test]
     fn messages_name_the_file_and_the_problem() {

@@ -21,7 +21,7 @@ fn case(name: &str) -> Case {
 }
 
 fn render(case: &Case) -> Film {
-    render_case(case, false).unwrap_or_else(|e| panic!("{e}"))
+    render_case(case).unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn render_with_threads(case: &Case, threads: usize) -> Film {

@@ -24,7 +24,7 @@ const CAMERA: &str = "[camera]\ncenter = [0, 0, 10]\ndirection = [0, 0, -1]\nup 
 
 fn render_in(dir: &Path, toml: &str) -> Result<Film, String> {
     let case = parse(toml, &dir.join("extreme.toml"), &LoadOptions::default()).map_err(|e| e.to_string())?;
-    render_case(&case, false).map_err(|e| e.to_string())
+    render_case(&case).map_err(|e| e.to_string())
 }
 
 fn render(toml: &str) -> Result<Film, String> {

@@ -76,7 +76,7 @@ fn render(path: &Path) -> Result<Rendered, String> {
     }
     let case =
         load(path, &LoadOptions::default()).map_err(|e| explain_missing_shared(path, e.to_string(), &shared_dir()))?;
-    let film = render_case(&case, false).map_err(|e| explain_missing_shared(path, e.to_string(), &shared_dir()))?;
+    let film = render_case(&case).map_err(|e| explain_missing_shared(path, e.to_string(), &shared_dir()))?;
     let exr = encode_exr(&film).map_err(|e| format!("{}: {e}", shown(path)))?;
     Ok(Rendered { case, film, exr })
 }

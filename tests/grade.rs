@@ -20,6 +20,7 @@ use std::sync::OnceLock;
 use std::time::Instant;
 
 use goldray::grade::{ClassReport, GradeOptions, Outcome, StudentResult, grade_class};
+use goldray::progress::Silent;
 
 use class::{Class, FILES, HOSTILE, POINTS, make_class_at};
 
@@ -41,10 +42,10 @@ fn graded() -> &'static Graded {
         let options = GradeOptions {
             out: out.clone(),
             cache: None,
-            show_progress: false,
         };
         let started = Instant::now();
-        let report = grade_class(&class.rubric, &class.submissions, &options).unwrap_or_else(|e| panic!("{e}"));
+        let report =
+            grade_class(&class.rubric, &class.submissions, &options, &Silent).unwrap_or_else(|e| panic!("{e}"));
         let seconds = started.elapsed().as_secs_f64();
         Graded {
             class,

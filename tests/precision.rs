@@ -21,7 +21,7 @@ fn case(name: &str, precision: Precision) -> Case {
 
 fn render_with_threads(case: &Case, threads: usize) -> Film {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-    pool.install(|| render_case(case, false).unwrap_or_else(|e| panic!("{e}")))
+    pool.install(|| render_case(case).unwrap_or_else(|e| panic!("{e}")))
 }
 
 #[test]

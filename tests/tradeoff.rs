@@ -11,6 +11,7 @@ use std::time::Duration;
 
 use goldray::case::{Case, LoadOptions, parse};
 use goldray::options::{Filter, Precision};
+use goldray::progress::Silent;
 use goldray::tradeoff::{
     CSV_COLUMNS, CSV_FILE, MARKDOWN_FILE, Metric, PLOT_FILE, PLOT_HEIGHT, PLOT_WIDTH, SweepPlan, Tradeoff,
     TradeoffOptions, measure_tradeoff, pareto_front, run_tradeoff,
@@ -36,7 +37,7 @@ fn measure(case: &Case, plan: SweepPlan) -> Tradeoff {
         plan,
         ..TradeoffOptions::new("unused")
     };
-    measure_tradeoff(case, &options).unwrap_or_else(|e| panic!("{e}"))
+    measure_tradeoff(case, &options, &Silent).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Thin dark shapes with sharp edges on a bright background, flat-lit: nearly all the error is
@@ -283,7 +284,8 @@ fn shipped(name: &str) -> PathBuf {
 fn the_report_reads_back_with_every_setting_and_the_plot_decodes() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("report");
-    let (t, written) = run_tradeoff(&shipped("mirrors.toml"), &tiny_options(&out)).unwrap_or_else(|e| panic!("{e}"));
+    let (t, written) =
+        run_tradeoff(&shipped("mirrors.toml"), &tiny_options(&out), &Silent).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(
         written,
         [out.join(CSV_FILE), out.join(MARKDOWN_FILE), out.join(PLOT_FILE)]
@@ -341,9 +343,9 @@ fn the_report_reads_back_with_every_setting_and_the_plot_decodes() {
     );
 
     // A second run replaces its own report; a file goldray did not write is refused untouched.
-    run_tradeoff(&shipped("mirrors.toml"), &tiny_options(&out)).unwrap_or_else(|e| panic!("{e}"));
+    run_tradeoff(&shipped("mirrors.toml"), &tiny_options(&out), &Silent).unwrap_or_else(|e| panic!("{e}"));
     fs::write(out.join(MARKDOWN_FILE), "# my notes\n").unwrap();
-    let refused = run_tradeoff(&shipped("mirrors.toml"), &tiny_options(&out)).unwrap_err();
+    let refused = run_tradeoff(&shipped("mirrors.toml"), &tiny_options(&out), &Silent).unwrap_err();
     assert!(refused.to_string().contains("--force"), "{refused}");
     assert_eq!(fs::read_to_string(out.join(MARKDOWN_FILE)).unwrap(), "# my notes\n");
     run_tradeoff(
@@ -352,6 +354,7 @@ fn the_report_reads_back_with_every_setting_and_the_plot_decodes() {
             force: true,
             ..tiny_options(&out)
         },
+        &Silent,
     )
     .unwrap();
     assert!(
@@ -371,11 +374,11 @@ fn the_target_is_the_fastest_setting_that_meets_it_or_a_clear_no() {
         target_flip: Some(target),
         ..TradeoffOptions::new("unused")
     };
-    let all = measure_tradeoff(&case(EDGES), &options(1.0)).unwrap();
+    let all = measure_tradeoff(&case(EDGES), &options(1.0), &Silent).unwrap();
     let chosen = all.target.unwrap().chosen.expect("every setting meets FLIP ≤ 1");
     let fastest = all.measurements.iter().map(|m| m.seconds).fold(f64::MAX, f64::min);
     assert_eq!(all.measurements[chosen].seconds, fastest);
-    let none = measure_tradeoff(&case(EDGES), &options(0.0)).unwrap();
+    let none = measure_tradeoff(&case(EDGES), &options(0.0), &Silent).unwrap();
     assert_eq!(none.target.unwrap().chosen, None);
     let sentence = none.target_sentence().unwrap();
     assert!(sentence.starts_with("no setting reached FLIP mean ≤ 0;"), "{sentence}");

@@ -88,7 +88,7 @@ pub fn parse(source: &str, path: &Path, options: &LoadOptions) -> Result<Case, C
 }
 
 /// A case is named after its file's stem: `cases/spheres.toml` renders `spheres.exr`.
-pub(crate) fn case_name(path: &Path) -> String {
+pub fn case_name(path: &Path) -> String {
     path.file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default()

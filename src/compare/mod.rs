@@ -15,18 +15,18 @@
 //! # }
 //! ```
 
-mod cli;
 mod comparison;
 mod error;
+mod files;
 mod flip;
 mod heatmap;
 mod image;
 mod metrics;
 mod verdict;
 
-pub use cli::{DiffArgs, EXR_DEFAULTS, PNG_DEFAULTS, UNREADABLE, diff_files, run_diff};
 pub use comparison::{Comparison, compare};
 pub use error::CompareError;
+pub use files::{EXR_DEFAULTS, FileComparison, PNG_DEFAULTS, ToleranceOverrides, compare_files};
 pub use heatmap::{FAILING, NON_FINITE, diff_heatmap};
 pub use image::{COLOR_CHANNELS, Channel, Encoding, Image};
 pub use metrics::{ChannelStats, Metrics, NonFinite, PixelError};

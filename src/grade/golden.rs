@@ -25,7 +25,8 @@ use crate::atomic_write::write_file_atomic;
 use crate::case::{Case, ObjectSpec, ShapeSpec};
 use crate::compare::Image;
 use crate::film::{Film, color_image, decode_exr, depth_image, encode_exr, normals_image, write_png};
-use crate::pipeline::render_case;
+use crate::pipeline::render_case_reporting;
+use crate::progress::Progress;
 
 /// Where the report keeps the golden PNGs, relative to the report directory.
 pub const GOLDEN_DIR: &str = "golden";
@@ -57,7 +58,7 @@ pub fn prepare_goldens(
     rubric: &Rubric,
     cache_dir: &Path,
     report_dir: &Path,
-    show_progress: bool,
+    progress: &dyn Progress,
 ) -> Result<Goldens, GradeError> {
     let mut films: HashMap<usize, Film> = HashMap::new();
     let mut by_key: HashMap<String, usize> = HashMap::new();
@@ -80,7 +81,11 @@ pub fn prepare_goldens(
         let (film, cached, cache_note) = match read_cached(&path, &source.case) {
             Some(film) => (film, true, None),
             None => {
-                let film = render_case(&source.case, show_progress).map_err(|source_error| GradeError::Golden {
+                let film = {
+                    progress.step(&format!("rendering golden {}", source.name));
+                    render_case_reporting(&source.case, progress)
+                }
+                .map_err(|source_error| GradeError::Golden {
                     location: source.location.clone(),
                     render: source.name.clone(),
                     source: Box::new(source_error),

@@ -21,12 +21,12 @@ const GAUSSIAN_WEIGHTS: [Real; 3] = [0.25, 0.5, 0.25];
 
 
 /// Renders the scene without counting anything.
-pub fn render(scene: &Scene, options: &RenderOptions, progress: &Progress) -> Film {
+pub fn render(scene: &Scene, options: &RenderOptions, progress: &dyn Progress) -> Film {
     render_counted::<NoCount>(scene, options, progress).0
 }
 
 /// [`render`], also counting every ray traced, by kind (for `--stats`). The film is the same.
-pub fn render_counting_rays(scene: &Scene, options: &RenderOptions, progress: &Progress) -> (Film, RayCounts) {
+pub fn render_counting_rays(scene: &Scene, options: &RenderOptions, progress: &dyn Progress) -> (Film, RayCounts) {
     render_counted::<RayCounts>(scene, options, progress)
 }
 
@@ -37,7 +37,7 @@ pub fn render_counting_rays(scene: &Scene, options: &RenderOptions, progress: &P
 /// Private, so that its only two copies are those above, compiled in this crate: a copy
 /// instantiated in another crate (a benchmark, say) would be optimised differently from the one
 /// the command line runs.
-fn render_counted<C: RayCounter>(scene: &Scene, options: &RenderOptions, progress: &Progress) -> (Film, C) {
+fn render_counted<C: RayCounter>(scene: &Scene, options: &RenderOptions, progress: &dyn Progress) -> (Film, C) {
     let mut film = Film::new(options.width, options.height);
     let pixels = PixelRenderer {
         scene,
@@ -68,7 +68,6 @@ fn render_counted<C: RayCounter>(scene: &Scene, options: &RenderOptions, progres
             counter
         })
         .reduce(C::default, C::merge);
-    progress.finish();
     (film, counter)
 }
 

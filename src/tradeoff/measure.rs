@@ -13,7 +13,7 @@ use crate::film::Film;
 use crate::options::{Filter, Precision, RenderOptions};
 use crate::pipeline::render_options;
 use crate::precision::{double, single};
-use crate::progress::Progress;
+use crate::progress::Silent;
 use crate::stats::RayCounts;
 
 /// A cheap setting is rendered again until its runs add up to the plan's `min_time`, but never
@@ -68,8 +68,8 @@ impl<'a> Renderer<'a> {
     /// One render of the film `options` describe, in `precision`, with its rays.
     fn render_once(&self, precision: Precision, options: &RenderOptions) -> (Film, RayCounts) {
         match precision {
-            Precision::F32 => single::render::render_counting_rays(&self.single, options, &Progress::hidden()),
-            Precision::F64 => double::render::render_counting_rays(&self.double, options, &Progress::hidden()),
+            Precision::F32 => single::render::render_counting_rays(&self.single, options, &Silent),
+            Precision::F64 => double::render::render_counting_rays(&self.double, options, &Silent),
         }
     }
 

@@ -269,6 +269,34 @@ pub fn significant(value: f64) -> String {
     }
 }
 
+/// What the terminal shows: the sweep's size, the bounce finding and the Pareto front.
+pub fn summary(t: &Tradeoff) -> String {
+    let front: Vec<String> = t
+        .front()
+        .map(|m| {
+            format!(
+                "{} ({} s, {} {})",
+                m.setting.label(),
+                significant(m.seconds),
+                t.metric.name(),
+                significant(t.metric.of(&m.errors))
+            )
+        })
+        .collect();
+    format!(
+        "{} at {}×{}: {} settings against a {} spp reference ({} bounces, {} s)\nbounces: {}\nPareto front: {}",
+        t.case_name,
+        t.width,
+        t.height,
+        t.measurements.len(),
+        t.reference.samples,
+        t.reference.bounces,
+        significant(t.reference.seconds),
+        bounce_sentence(t),
+        front.join(", ")
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

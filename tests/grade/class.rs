@@ -71,7 +71,7 @@ fn case() -> Case {
 }
 
 fn render(case: &Case) -> Film {
-    render_case(case, false).unwrap_or_else(|e| panic!("{e}"))
+    render_case(case).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Colour, normals and depth as the course binary writes them.

@@ -5,6 +5,7 @@ use std::path::Path;
 use std::process::Command;
 
 use goldray::grade::{ClassReport, GradeOptions, grade_class};
+use goldray::progress::Silent;
 
 use crate::class::make_class;
 
@@ -16,9 +17,8 @@ fn goldens_are_rendered_once_then_read_from_the_cache() {
         let options = GradeOptions {
             out: class.dir.join(out),
             cache: Some(cache.clone()),
-            show_progress: false,
         };
-        grade_class(&class.rubric, &class.submissions, &options).unwrap_or_else(|e| panic!("{e}"))
+        grade_class(&class.rubric, &class.submissions, &options, &Silent).unwrap_or_else(|e| panic!("{e}"))
     };
     let first = grade("first");
     assert_eq!(first.goldens.len(), 1, "three images, one render");

@@ -2,15 +2,16 @@
 //! anything renders or is written), and what the command prints.
 
 use std::path::PathBuf;
+use std::process::ExitCode;
 use std::time::Duration;
 
-use super::error::TradeoffError;
-use super::measure::Metric;
-use super::report::significant;
-use super::sweep::{DEFAULT_FILTERS, SweepPlan};
-use super::{Tradeoff, TradeoffOptions, run_tradeoff};
-use crate::case::{MAX_BOUNCES, MAX_IMAGE_SIZE, case_name};
-use crate::options::{Filter, Precision};
+use goldray::case::{MAX_BOUNCES, case_name};
+use goldray::options::{Filter, Precision};
+use goldray::tradeoff::{DEFAULT_FILTERS, Metric, SweepPlan, TradeoffOptions, run_tradeoff, summary};
+
+use super::Failure;
+use super::common::{ThreadFlags, parse_size, parse_threshold};
+use super::progress::Reporter;
 
 /// Render a case over a sweep of samples, filters, precisions and bounces; measure each setting's time, rays
 /// and error against a converged reference; write tradeoff.csv, tradeoff.md and a log-log plot
@@ -63,9 +64,8 @@ pub struct TradeoffArgs {
     /// The error the plot and the Pareto front rank settings by.
     #[arg(long, value_enum, default_value_t = Metric::Rmse)]
     pub metric: Metric,
-    /// Worker threads (default: one per core). Times depend on it; pictures and rays do not.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
-    pub threads: Option<u32>,
+    #[command(flatten)]
+    pub threads: ThreadFlags,
     /// No progress bar and no summary (the --target-flip answer is still printed).
     #[arg(long)]
     pub quiet: bool,
@@ -75,7 +75,7 @@ pub struct TradeoffArgs {
 }
 
 impl TradeoffArgs {
-    pub fn options(&self) -> TradeoffOptions {
+    fn options(&self) -> TradeoffOptions {
         TradeoffOptions {
             out: self
                 .out
@@ -94,19 +94,17 @@ impl TradeoffArgs {
             metric: self.metric,
             target_flip: self.target_flip,
             force: self.force,
-            show_progress: !self.quiet,
         }
     }
 }
 
 /// Runs `goldray tradeoff` on its own thread pool and prints the summary to standard output.
-pub fn run_tradeoff_command(args: &TradeoffArgs) -> Result<Tradeoff, TradeoffError> {
-    let mut pool = rayon::ThreadPoolBuilder::new();
-    if let Some(threads) = args.threads {
-        pool = pool.num_threads(threads as usize);
-    }
+pub fn run(args: TradeoffArgs) -> Result<ExitCode, Failure> {
     let options = args.options();
-    let (tradeoff, written) = pool.build()?.install(|| run_tradeoff(&args.case, &options))?;
+    let reporter = Reporter::new(args.quiet);
+    let (tradeoff, written) = args
+        .threads
+        .install(|| run_tradeoff(&args.case, &options, &reporter))??;
     if !args.quiet {
         println!("{}", summary(&tradeoff));
         for path in &written {
@@ -116,35 +114,7 @@ pub fn run_tradeoff_command(args: &TradeoffArgs) -> Result<Tradeoff, TradeoffErr
     if let Some(sentence) = tradeoff.target_sentence() {
         println!("target: {sentence}");
     }
-    Ok(tradeoff)
-}
-
-/// What the terminal shows: the sweep's size, the bounce finding and the Pareto front.
-fn summary(t: &Tradeoff) -> String {
-    let front: Vec<String> = t
-        .front()
-        .map(|m| {
-            format!(
-                "{} ({} s, {} {})",
-                m.setting.label(),
-                significant(m.seconds),
-                t.metric.name(),
-                significant(t.metric.of(&m.errors))
-            )
-        })
-        .collect();
-    format!(
-        "{} at {}×{}: {} settings against a {} spp reference ({} bounces, {} s)\nbounces: {}\nPareto front: {}",
-        t.case_name,
-        t.width,
-        t.height,
-        t.measurements.len(),
-        t.reference.samples,
-        t.reference.bounces,
-        significant(t.reference.seconds),
-        super::report::bounce_sentence(t),
-        front.join(", ")
-    )
+    Ok(ExitCode::SUCCESS)
 }
 
 fn parse_square(text: &str) -> Result<u32, String> {
@@ -180,21 +150,6 @@ fn parse_precision(text: &str) -> Result<Precision, String> {
         .ok_or_else(|| format!("`{text}` is not a precision: f32 or f64"))
 }
 
-fn parse_size(text: &str) -> Result<(u32, u32), String> {
-    let usage = || format!("`{text}` is not a size: give WIDTHxHEIGHT, e.g. 64x48");
-    let (width, height) = text.split_once(['x', 'X', '×']).ok_or_else(usage)?;
-    let side = |s: &str| {
-        s.trim()
-            .parse::<u32>()
-            .ok()
-            .filter(|&v| v >= 1 && i64::from(v) <= MAX_IMAGE_SIZE)
-    };
-    match (side(width), side(height)) {
-        (Some(w), Some(h)) => Ok((w, h)),
-        _ => Err(format!("{} (each side between 1 and {MAX_IMAGE_SIZE})", usage())),
-    }
-}
-
 fn parse_flip(text: &str) -> Result<f64, String> {
     match text.trim().parse::<f64>() {
         Ok(x) if (0.0..=1.0).contains(&x) => Ok(x),
@@ -209,13 +164,6 @@ fn parse_seconds(text: &str) -> Result<f64, String> {
     }
 }
 
-fn parse_threshold(text: &str) -> Result<f64, String> {
-    match text.trim().parse::<f64>() {
-        Ok(x) if x.is_finite() && x >= 0.0 => Ok(x),
-        _ => Err(format!("`{text}` is not a threshold: a finite number ≥ 0")),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -226,17 +174,12 @@ mod tests {
         assert!(parse_square("8").unwrap_err().contains("nearest are 4 and 9"));
         assert!(parse_square("0").unwrap_err().contains("perfect square"));
         assert!(parse_square("four").unwrap_err().contains("whole number"));
-        assert_eq!(parse_size("64x48"), Ok((64, 48)));
-        assert!(parse_size("64").unwrap_err().contains("WIDTHxHEIGHT"));
-        assert!(parse_size("0x10").unwrap_err().contains("between 1"));
-        assert!(parse_size("99999x10").unwrap_err().contains("16384"));
         assert_eq!(parse_filter("gaussian"), Ok(Filter::Gaussian));
         assert!(parse_filter("box").unwrap_err().contains("none or gaussian"));
         assert_eq!(parse_precision("f64"), Ok(Precision::F64));
         assert!(parse_precision("f16").unwrap_err().contains("f32 or f64"));
         assert_eq!(parse_flip("0.05"), Ok(0.05));
         assert!(parse_flip("1.5").is_err() && parse_flip("nan").is_err());
-        assert!(parse_threshold("-1").is_err() && parse_threshold("inf").is_err());
         assert_eq!(parse_seconds("0"), Ok(0.0));
         assert!(parse_seconds("-0.5").is_err() && parse_seconds("nan").is_err());
     }
