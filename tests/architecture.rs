@@ -121,7 +121,11 @@ fn every_import_points_to_a_lower_layer() {
             }
         }
     }
-    assert!(violations.is_empty(), "imports against the layering:\n{}", violations.join("\n"));
+    assert!(
+        violations.is_empty(),
+        "imports against the layering:\n{}",
+        violations.join("\n")
+    );
 }
 
 #[test]
@@ -139,14 +143,21 @@ fn the_library_neither_prints_nor_parses_flags() {
             }
         }
     }
-    assert!(found.is_empty(), "printing or flag parsing in the library:\n{}", found.join("\n"));
+    assert!(
+        found.is_empty(),
+        "printing or flag parsing in the library:\n{}",
+        found.join("\n")
+    );
 }
 
 #[test]
 fn the_checker_sees_imports_it_must_refuse() {
     assert_eq!(references("use crate::case::{Case, Tolerance};", false), ["case"]);
     assert_eq!(references("use super::render::camera::Camera;", true), ["render"]);
-    assert_eq!(references("use super::{geometry, real, render};", true), ["geometry", "real", "render"]);
+    assert_eq!(
+        references("use super::{geometry, real, render};", true),
+        ["geometry", "real", "render"]
+    );
     assert!(references("use super::integrator::Whitted;", true).is_empty());
     assert!(layer("compare") < layer("case") && layer("scene") < layer("render"));
 }

@@ -17,18 +17,47 @@ pub const USAGE: &str = "goldray mit6837 -input scene.txt -output out.png [-norm
                          [-depth min max d.png] [-bounces n] [-shadows] [-jitter] [-filter] [--exr out.exr] \
                          [--threads N] [--quiet] [--force] [--stats] [--stats-json FILE]";
 
+/// The flags the course binary itself takes, which help shows with one dash, as the course does.
+const COURSE_FLAGS: [&str; 9] = [
+    "input", "output", "normals", "depth", "size", "bounces", "shadows", "jitter", "filter",
+];
+
+/// clap's help for `mit6837` with the course's flags spelled as the course spells them
+/// (`-input`, not `--input`); goldray's own additions keep their two dashes.
+pub fn course_style_help(clap_help: &str) -> String {
+    clap_help
+        .lines()
+        .map(|line| {
+            let trimmed = line.trim_start();
+            let indent = line.len() - trimmed.len();
+            match COURSE_FLAGS.iter().find(|flag| {
+                trimmed
+                    .strip_prefix("--")
+                    .and_then(|rest| rest.strip_prefix(**flag))
+                    .is_some_and(|rest| rest.is_empty() || rest.starts_with(' '))
+            }) {
+                // One dash fewer, one space more: the columns stay aligned.
+                Some(_) => format!("{} {}", " ".repeat(indent), &trimmed[1..]),
+                None => line.to_owned(),
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+        + "\n"
+}
+
 #[derive(clap::Args)]
 pub struct Mit6837Args {
-    /// -input: the course scene file.
+    /// The course scene file.
     #[arg(long, value_name = "scene.txt")]
     input: PathBuf,
-    /// -output: colour PNG (trunc(c·255), no gamma, like the course binary).
+    /// Colour PNG (trunc(c·255), no gamma, like the course binary).
     #[arg(long, value_name = "out.png")]
     output: Option<PathBuf>,
-    /// -normals: normals PNG, (n+1)/2.
+    /// Normals PNG, (n+1)/2.
     #[arg(long, value_name = "n.png")]
     normals: Option<PathBuf>,
-    /// -depth min max d.png: distances from min (black) to max (white).
+    /// Depth PNG: distances from min (black) to max (white).
     #[arg(long, num_args = 3, value_names = ["min", "max", "d.png"], allow_negative_numbers = true)]
     depth: Option<Vec<String>>,
     /// Also write goldray's linear EXR (colour, depth, normals) here.
@@ -44,19 +73,19 @@ pub struct Mit6837Args {
 /// case renders exactly what the same course command would.
 #[derive(clap::Args)]
 pub struct CourseFlags {
-    /// -size w h: image width and height (also WxH) [default: 100 100].
+    /// Image width and height (also WxH) [default: 100 100].
     #[arg(long, num_args = 1..=2, value_names = ["w", "h"], allow_negative_numbers = true)]
     size: Option<Vec<String>>,
-    /// -bounces n: mirror recursion depth.
+    /// Mirror recursion depth.
     #[arg(long, value_name = "n", default_value_t = 0)]
     bounces: u32,
-    /// -shadows: trace shadow rays.
+    /// Trace shadow rays.
     #[arg(long)]
     shadows: bool,
-    /// -jitter: 16 stratified jittered samples per pixel.
+    /// 16 stratified jittered samples per pixel.
     #[arg(long)]
     jitter: bool,
-    /// -filter: render at 3× and down-filter with the 3×3 Gaussian.
+    /// Render at 3× and down-filter with the 3×3 Gaussian.
     #[arg(long)]
     filter: bool,
 }
@@ -129,4 +158,18 @@ pub fn run(args: Mit6837Args) -> Result<ExitCode, Failure> {
     }
     let rendered = run.render(|reporter| render_assignment(&input, &options, &outputs, reporter))?;
     run.report(&rendered)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn help_spells_the_course_flags_with_one_dash_and_keeps_the_columns() {
+        let help = "Options:\n      --input <scene.txt>  The scene\n      --exr <out.exr>      EXR\n      --shadows            Shadows\n      --size <w> [h]       Size\n";
+        assert_eq!(
+            course_style_help(help),
+            "Options:\n       -input <scene.txt>  The scene\n      --exr <out.exr>      EXR\n       -shadows            Shadows\n       -size <w> [h]       Size\n"
+        );
+    }
 }

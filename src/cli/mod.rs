@@ -14,7 +14,7 @@ mod tradeoff;
 
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 
 /// A deterministic Whitted ray tracer and scene-to-image regression harness.
 #[derive(Parser)]
@@ -60,10 +60,31 @@ impl<E: std::fmt::Display> From<E> for Failure {
     }
 }
 
+/// `goldray mit6837 --help` (or `-help`, or `goldray help mit6837`).
+fn asks_for_course_help(args: &[std::ffi::OsString]) -> bool {
+    match args.get(1).and_then(|a| a.to_str()) {
+        Some("mit6837") => true,
+        Some("help") => args.get(2).is_some_and(|a| a == "mit6837"),
+        _ => false,
+    }
+}
+
 /// Parses the command line (rewriting the course's single-dash flags first), runs the command
 /// and turns its outcome into the process's exit code.
 pub fn main() -> ExitCode {
-    let cli = Cli::parse_from(course_flags::rewrite(std::env::args_os()));
+    let args = course_flags::rewrite(std::env::args_os());
+    let cli = match Cli::try_parse_from(&args) {
+        Ok(cli) => cli,
+        Err(error) if error.kind() == clap::error::ErrorKind::DisplayHelp && asks_for_course_help(&args) => {
+            let help = Cli::command()
+                .find_subcommand_mut("mit6837")
+                .map(|command| command.render_help().to_string())
+                .unwrap_or_default();
+            print!("{}", mit6837::course_style_help(&help));
+            return ExitCode::SUCCESS;
+        }
+        Err(error) => error.exit(),
+    };
     let outcome = match cli.command {
         Command::Render(args) => render::run(args),
         Command::Mit6837(args) => mit6837::run(args),

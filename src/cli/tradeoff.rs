@@ -7,11 +7,17 @@ use std::time::Duration;
 
 use goldray::case::{MAX_BOUNCES, case_name};
 use goldray::options::{Filter, Precision};
-use goldray::tradeoff::{DEFAULT_FILTERS, Metric, SweepPlan, TradeoffOptions, run_tradeoff, summary};
+use goldray::tradeoff::{Metric, SweepPlan, TradeoffOptions, run_tradeoff, summary};
 
 use super::Failure;
 use super::common::{ThreadFlags, parse_size, parse_threshold};
 use super::progress::Reporter;
+
+// The list defaults as the flags accept them (help shows them as written); a test checks they
+// are the library's defaults.
+const DEFAULT_SAMPLES: &str = "1,4,16,64,256";
+const DEFAULT_FILTER_LIST: &str = "none,gaussian";
+const DEFAULT_PRECISIONS: &str = "f32,f64";
 
 /// Render a case over a sweep of samples, filters, precisions and bounces; measure each setting's time, rays
 /// and error against a converged reference; write tradeoff.csv, tradeoff.md and a log-log plot
@@ -29,15 +35,15 @@ pub struct TradeoffArgs {
     pub target_flip: Option<f64>,
     /// Samples per pixel of the grid: comma-separated perfect squares (e.g. 1,4,16).
     #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_square,
-          default_values_t = SweepPlan::default().samples)]
+          default_value = DEFAULT_SAMPLES)]
     pub samples: Vec<u32>,
     /// Filters of the grid: comma-separated, from none and gaussian (3× supersampling, 9× the rays).
     #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_filter,
-          default_values = DEFAULT_FILTERS.map(Filter::name))]
+          default_value = DEFAULT_FILTER_LIST)]
     pub filters: Vec<Filter>,
     /// Precisions of the grid: comma-separated, from f32 and f64 (the reference is always f64).
     #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_precision,
-          default_values = Precision::ALL.map(Precision::name))]
+          default_value = DEFAULT_PRECISIONS)]
     pub precisions: Vec<Precision>,
     /// Render every setting and the reference at this size instead of the case's (e.g. 64x48):
     /// a quicker sweep.
@@ -167,6 +173,27 @@ fn parse_seconds(text: &str) -> Result<f64, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use goldray::tradeoff::DEFAULT_FILTERS;
+
+    #[test]
+    fn list_defaults_are_the_library_defaults_in_the_syntax_the_flags_take() {
+        let split = |list: &str| list.split(',').map(str::to_owned).collect::<Vec<_>>();
+        let samples: Vec<u32> = split(DEFAULT_SAMPLES)
+            .iter()
+            .map(|s| parse_square(s).unwrap())
+            .collect();
+        assert_eq!(samples, SweepPlan::default().samples);
+        let filters: Vec<Filter> = split(DEFAULT_FILTER_LIST)
+            .iter()
+            .map(|s| parse_filter(s).unwrap())
+            .collect();
+        assert_eq!(filters, DEFAULT_FILTERS);
+        let precisions: Vec<Precision> = split(DEFAULT_PRECISIONS)
+            .iter()
+            .map(|s| parse_precision(s).unwrap())
+            .collect();
+        assert_eq!(precisions, Precision::ALL);
+    }
 
     #[test]
     fn flag_values_are_checked_with_reasons() {
