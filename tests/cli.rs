@@ -330,17 +330,30 @@ fn diff_prints_its_verdict_even_when_the_heatmap_cannot_be_written() {
 
 #[test]
 fn help_speaks_each_command_s_own_syntax() {
-    for args in [&["mit6837", "--help"][..], &["mit6837", "-help"][..], &["help", "mit6837"][..]] {
+    for args in [
+        &["mit6837", "--help"][..],
+        &["mit6837", "-help"][..],
+        &["help", "mit6837"][..],
+    ] {
         let help = goldray(args);
         assert!(help.status.success());
         let text = String::from_utf8_lossy(&help.stdout);
-        assert!(text.contains(" -input <scene.txt>") && !text.contains("--input"), "{text}");
+        assert!(
+            text.contains(" -input <scene.txt>") && !text.contains("--input"),
+            "{text}"
+        );
         assert!(text.contains("--exr"), "goldray's own flags keep two dashes: {text}");
     }
     let tradeoff = goldray(&["tradeoff", "--help"]);
     let text = String::from_utf8_lossy(&tradeoff.stdout);
-    assert!(text.contains("[default: 1,4,16,64,256]") && text.contains("[default: none,gaussian]"), "{text}");
+    assert!(
+        text.contains("[default: 1,4,16,64,256]") && text.contains("[default: none,gaussian]"),
+        "{text}"
+    );
     let grade = goldray(&["grade", "--help"]);
     let text = String::from_utf8_lossy(&grade.stdout);
-    assert!(text.contains("--threads") && !text.contains("--jobs"), "--jobs is a hidden alias: {text}");
+    assert!(
+        text.contains("--threads") && !text.contains("--jobs"),
+        "--jobs is a hidden alias: {text}"
+    );
 }

@@ -21,7 +21,8 @@ pub struct GradeArgs {
     out: PathBuf,
     #[command(flatten)]
     threads: ThreadFlags,
-    /// Golden image cache (default: OUT/cache); share one between reports to render once.
+    /// Golden image cache [default: the user cache folder's goldray/goldens, e.g.
+    /// ~/.cache/goldray/goldens]. Entries are named by content, so one cache serves every report.
     #[arg(long)]
     cache: Option<PathBuf>,
     /// No progress and no summary.

@@ -52,6 +52,18 @@ pub struct Goldens {
     pub images: Vec<Image>,
 }
 
+/// Where golden renders are cached unless the caller says otherwise: the user's cache folder
+/// (`$XDG_CACHE_HOME/goldray/goldens`, usually `~/.cache/goldray/goldens`, on Linux;
+/// `~/Library/Caches/goldray/goldens` on macOS), or the system's temporary folder when there is
+/// none. Outside the report, so that zipping a report to send it does not drag the cache along;
+/// shared by every report, which is safe because entries are named by a hash of their content.
+pub fn default_cache_dir() -> PathBuf {
+    dirs::cache_dir()
+        .unwrap_or_else(std::env::temp_dir)
+        .join("goldray")
+        .join("goldens")
+}
+
 /// Renders (or loads from `cache_dir`) every render an image uses, and writes each golden picture
 /// to `REPORT/golden/FILE` for the HTML report.
 pub fn prepare_goldens(

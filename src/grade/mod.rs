@@ -38,7 +38,7 @@ use rayon::prelude::*;
 
 use crate::progress::Progress;
 pub use error::GradeError;
-pub use golden::{GoldenRender, Goldens, prepare_goldens};
+pub use golden::{GoldenRender, Goldens, default_cache_dir, prepare_goldens};
 pub use outcome::Outcome;
 pub use report::{ClassReport, RubricSummary};
 pub use rubric::{ImageSpec, Output, RenderSource, Rubric, Rule, load_rubric, parse_rubric};
@@ -48,7 +48,7 @@ pub use score::{ImageResult, StudentResult, Submission, grade_image, judge};
 #[derive(Clone, Debug)]
 pub struct GradeOptions {
     pub out: PathBuf,
-    /// `None`: `out/cache`.
+    /// `None`: [`default_cache_dir`].
     pub cache: Option<PathBuf>,
 }
 
@@ -64,7 +64,7 @@ pub fn grade_class(
 ) -> Result<ClassReport, GradeError> {
     let rubric = load_rubric(rubric_path)?;
     let out = &options.out;
-    let cache = options.cache.clone().unwrap_or_else(|| out.join("cache"));
+    let cache = options.cache.clone().unwrap_or_else(default_cache_dir);
     let (folders, ignored) = student_folders(submissions, &[out, &cache])?;
     let goldens = prepare_goldens(&rubric, &cache, out, progress)?;
 
@@ -105,6 +105,7 @@ pub fn grade_class(
         goldray: env!("CARGO_PKG_VERSION"),
         rubric: RubricSummary::of(&rubric),
         submissions: submissions.to_path_buf(),
+        cache: cache.clone(),
         goldens: goldens.renders,
         ignored,
         students,
@@ -154,7 +155,7 @@ pub fn summary(report: &ClassReport, out: &Path) -> String {
     let counts: Vec<String> = counts.iter().map(|(word, n)| format!("{n} {word}")).collect();
     let rendered = report.goldens.iter().filter(|g| !g.cached).count();
     format!(
-        "graded {} students on {} images ({}); {} golden renders ({rendered} rendered, {} cached)\nreport: {}",
+        "graded {} students on {} images ({}); {} golden renders ({rendered} rendered, {} cached in {})\nreport: {}",
         report.students.len(),
         report.rubric.images.len(),
         if counts.is_empty() {
@@ -164,6 +165,7 @@ pub fn summary(report: &ClassReport, out: &Path) -> String {
         },
         report.goldens.len(),
         report.goldens.len() - rendered,
+        report.cache.display(),
         out.join("index.html").display()
     )
 }

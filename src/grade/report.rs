@@ -19,6 +19,8 @@ pub struct ClassReport {
     pub goldray: &'static str,
     pub rubric: RubricSummary,
     pub submissions: PathBuf,
+    /// Where the golden renders were cached.
+    pub cache: PathBuf,
     pub goldens: Vec<GoldenRender>,
     /// Entries of the submissions folder that are not student folders (loose files), by name.
     pub ignored: Vec<String>,
