@@ -542,3 +542,43 @@ fn bad_input_is_a_clear_error_and_writes_nothing() {
     assert_eq!(fs::read_to_string(out.join(CSV_FILE)).unwrap(), "name,score\nada,10\n");
     assert_eq!(fs::read_dir(&out).unwrap().count(), 1, "nothing else written");
 }
+
+/// When stderr is a log rather than a terminal, a long sweep still says what it is doing: one
+/// line per setting and one for the reference; `--quiet` silences them.
+#[test]
+fn progress_is_a_line_per_setting_when_stderr_is_not_a_terminal() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = shipped("mirrors.toml");
+    let args = |out: &str| -> Vec<String> {
+        let mut args: Vec<String> = ["tradeoff", case.to_str().unwrap(), "--out", out]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        args.extend(QUICK.iter().filter(|a| **a != "--quiet").map(|s| s.to_string()));
+        args
+    };
+    let out = dir.path().join("talking");
+    let talking = goldray(
+        &args(out.to_str().unwrap())
+            .iter()
+            .map(String::as_str)
+            .collect::<Vec<_>>(),
+    );
+    assert!(talking.status.success(), "{}", stderr(&talking));
+    let log = stderr(&talking);
+    let rows = fs::read_to_string(out.join(CSV_FILE)).unwrap().lines().count() - 1;
+    assert!(log.lines().any(|l| l.starts_with("reference (16 spp)")), "{log}");
+    // Setting labels read like `4spp gaussian 1b f32`.
+    let setting_lines = log
+        .lines()
+        .filter(|l| l.contains("spp ") && (l.ends_with(" f32") || l.ends_with(" f64")))
+        .count();
+    assert!(setting_lines >= rows, "one line per setting ({rows}):\n{log}");
+
+    let quiet_out = dir.path().join("quiet");
+    let mut quiet_args = args(quiet_out.to_str().unwrap());
+    quiet_args.push("--quiet".to_owned());
+    let quiet = goldray(&quiet_args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(quiet.status.success());
+    assert!(stderr(&quiet).is_empty(), "{}", stderr(&quiet));
+}
