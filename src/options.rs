@@ -9,7 +9,8 @@ pub enum Profile {
     /// Pixel centres, vertical fov with aspect correction, orthonormal camera basis.
     #[default]
     Native,
-    /// The course's reference renderer, quirks included (DESIGN.md, "The assignment profile").
+    /// The course's reference renderer, quirks included (docs/ARCHITECTURE.md,
+    /// "The assignment profile").
     Mit6837,
 }
 
