@@ -13,6 +13,7 @@ pub mod compare;
 pub mod error;
 pub mod film;
 pub mod grade;
+pub mod located_toml;
 pub mod options;
 pub mod pipeline;
 pub mod precision;

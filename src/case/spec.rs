@@ -5,8 +5,8 @@ use std::path::PathBuf;
 
 use glam::{DMat4, DVec3};
 
-use super::error::SourceLocation;
 use crate::film::Tonemap;
+use crate::located_toml::SourceLocation;
 use crate::options::{Filter, Precision, Profile};
 
 /// One case file: a scene, how to render it, and how far it may drift from its golden image.
