@@ -10,8 +10,8 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::golden::GOLDEN_DIR;
-use super::report::{ClassReport, format_points};
 use super::outcome::Outcome;
+use super::report::{ClassReport, format_points};
 use super::score::{ImageResult, StudentResult, percent};
 use crate::atomic_write::write_file_atomic;
 use crate::compare::Metrics;
