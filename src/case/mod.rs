@@ -23,9 +23,12 @@ pub use error::CaseError;
 pub use export::case_to_toml;
 pub use sections::{MAX_BOUNCES, MAX_IMAGE_SIZE};
 pub use spec::{
-    BackgroundSpec, CameraSpec, Case, LightSpec, MaterialSpec, ObjectSpec, RenderSettings, ShapeSpec, Tolerance,
-    TransformOp, composite_matrix,
+    BackgroundSpec, CameraSpec, Case, LightSpec, MaterialSpec, ObjectSpec, RenderSettings, ShapeSpec, TransformOp,
+    composite_matrix,
 };
+
+/// The comparator's settings, which a case's `[tolerance]` table fills in.
+pub use crate::compare::Tolerance;
 
 use crate::located_toml::{self, Doc, Table};
 

@@ -7,8 +7,9 @@ use glam::DVec3;
 
 use super::LoadOptions;
 use super::error::CaseError;
-use super::spec::{BackgroundSpec, CameraSpec, LightSpec, MaterialSpec, RenderSettings, Tolerance};
+use super::spec::{BackgroundSpec, CameraSpec, LightSpec, MaterialSpec, RenderSettings};
 use super::value::SceneValues;
+use crate::compare::Tolerance;
 use crate::film::Tonemap;
 use crate::located_toml::{Doc, Field, Result, Table};
 use crate::options::Profile;

@@ -22,6 +22,7 @@ mod flip;
 mod heatmap;
 mod image;
 mod metrics;
+mod tolerance;
 mod verdict;
 
 pub use cli::{DiffArgs, EXR_DEFAULTS, PNG_DEFAULTS, UNREADABLE, diff_files, run_diff};
@@ -30,4 +31,5 @@ pub use error::CompareError;
 pub use heatmap::{FAILING, NON_FINITE, diff_heatmap};
 pub use image::{COLOR_CHANNELS, Channel, Encoding, Image};
 pub use metrics::{ChannelStats, Metrics, NonFinite, PixelError};
+pub use tolerance::Tolerance;
 pub use verdict::{Breach, Layout, Limit, Verdict};

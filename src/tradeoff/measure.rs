@@ -7,8 +7,8 @@ use std::time::{Duration, Instant};
 
 use super::error::TradeoffError;
 use super::setting::Setting;
-use crate::case::{Case, Tolerance};
-use crate::compare::{Image, compare};
+use crate::case::Case;
+use crate::compare::{Image, Tolerance, compare};
 use crate::film::Film;
 use crate::options::{Filter, Precision, RenderOptions};
 use crate::pipeline::render_options;
