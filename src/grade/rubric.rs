@@ -6,11 +6,12 @@
 
 use std::path::{Path, PathBuf};
 
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 use super::error::RubricError;
 use crate::case::{self, AssignmentOptions, Case, LoadOptions, MAX_BOUNCES, MAX_IMAGE_SIZE, load_assignment_scene};
 use crate::located_toml::{self, Doc, Field, SourceLocation, Table, suggest};
+use crate::named_enum::named_enum;
 
 /// A whole rubric, every path resolved and every render source loaded.
 #[derive(Clone, Debug)]
@@ -46,13 +47,13 @@ pub enum Output {
     },
 }
 
-/// What `output = "…"` may say.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "lowercase")]
-enum OutputKind {
-    Color,
-    Normals,
-    Depth,
+named_enum! {
+    /// What `output = "…"` may say.
+    enum OutputKind: "output" {
+        Color = "color",
+        Normals = "normals",
+        Depth = "depth",
+    }
 }
 
 /// One `[image."FILE"]`: an expected file of every submission.

@@ -3,11 +3,11 @@
 use std::fmt;
 use std::ops::{Range, RangeInclusive};
 
-use serde::de::{DeserializeOwned, IntoDeserializer};
 use toml::Spanned;
 use toml::de::{DeString, DeTable, DeValue};
 
 use super::{Doc, LocatedError, Result, suggest};
+use crate::named_enum::NamedEnum;
 
 type Value<'i> = Spanned<DeValue<'i>>;
 
@@ -247,37 +247,13 @@ impl<'a, 'i> Field<'a, 'i> {
         Ok(out)
     }
 
-    /// A string naming a variant of one of the crate's serde enums. The valid names come from the
-    /// enum's own derive, so they cannot drift from what the renderer accepts.
-    pub fn variant<T: DeserializeOwned>(&self) -> Result<T> {
+    /// A string naming a variant of one of the crate's option enums. The valid names come from
+    /// the enum's own definition, so they cannot drift from what the renderer accepts.
+    pub fn variant<T: NamedEnum>(&self) -> Result<T> {
         let written = self.string()?;
-        T::deserialize(IntoDeserializer::<VariantError>::into_deserializer(written)).map_err(|e| {
-            let tail = suggest(written, e.expected, "values");
+        T::from_name(written).ok_or_else(|| {
+            let tail = suggest(written, T::NAMES, "values");
             self.error(format!("unknown {} `{written}`{tail}", self.name))
         })
-    }
-}
-
-/// Captures the variant list that serde's derive hands to `unknown_variant`.
-#[derive(Debug)]
-struct VariantError {
-    expected: &'static [&'static str],
-}
-
-impl fmt::Display for VariantError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "expected one of {}", self.expected.join(", "))
-    }
-}
-
-impl std::error::Error for VariantError {}
-
-impl serde::de::Error for VariantError {
-    fn custom<T: fmt::Display>(_: T) -> Self {
-        VariantError { expected: &[] }
-    }
-
-    fn unknown_variant(_: &str, expected: &'static [&'static str]) -> Self {
-        VariantError { expected }
     }
 }
