@@ -14,6 +14,8 @@ pub mod error;
 pub mod film;
 pub mod grade;
 pub mod image_size;
+pub mod located_toml;
+pub mod named_enum;
 pub mod options;
 pub mod pipeline;
 pub mod precision;

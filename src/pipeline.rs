@@ -147,7 +147,8 @@ fn measured_run(
         total: start.elapsed(),
     };
     let stats = RenderStats::new(
-        &case,
+        &case.name,
+        (case.render.width, case.render.height),
         phases,
         measured.build_stats,
         &measured.rays,

@@ -8,8 +8,10 @@ mod diff_cli;
 
 use std::path::Path;
 
-use goldray::case::{Case, LoadOptions, Tolerance, load, parse};
-use goldray::compare::{Comparison, EXR_DEFAULTS, FAILING, Image, Limit, NON_FINITE, Verdict, compare, diff_heatmap};
+use goldray::case::{Case, LoadOptions, load, parse};
+use goldray::compare::{
+    Comparison, EXR_DEFAULTS, FAILING, Image, Limit, NON_FINITE, Tolerance, Verdict, compare, diff_heatmap,
+};
 use goldray::film::Film;
 use goldray::pipeline::render_case;
 

@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
-use goldray::case::{Case, LoadOptions, Tolerance, case_to_toml, load, parse};
-use goldray::compare::{Image, Verdict, compare};
+use goldray::case::{Case, LoadOptions, case_to_toml, load, parse};
+use goldray::compare::{Image, Tolerance, Verdict, compare};
 use goldray::film::{Film, encode_exr};
 use goldray::options::Precision;
 use goldray::pipeline::render_case;

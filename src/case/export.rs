@@ -9,7 +9,6 @@ use std::path::{Path, PathBuf};
 
 use super::spec::{BackgroundSpec, Case, LightSpec, ObjectSpec, ShapeSpec, TransformOp};
 use super::{LoadOptions, parse};
-use crate::film::Tonemap;
 use crate::options::Profile;
 
 /// `toml_path` is where the file will live: asset paths are written relative to its directory
@@ -79,7 +78,7 @@ fn defaults(profile: Profile) -> Case {
     let skeleton = format!(
         "[render]\nprofile = {}\n[camera]\ncenter = [0, 0, 0]\ndirection = [0, 0, -1]\n\
          up = [0, 1, 0]\nfov = 30\n[materials.m]\n",
-        string(profile_name(profile))
+        string(profile.name())
     );
     parse(&skeleton, Path::new("defaults.toml"), &LoadOptions::default())
         .expect("the skeleton case is valid for every profile")
@@ -95,7 +94,7 @@ impl Writer<'_> {
         let (r, d) = (&self.case.render, &defaults.render);
         let mut out = format!(
             "\n[render]\nprofile = {}\nsize = [{}, {}]\n",
-            string(profile_name(r.profile)),
+            string(r.profile.name()),
             r.width,
             r.height
         );
@@ -110,7 +109,7 @@ impl Writer<'_> {
             ("filter", r.filter != d.filter, string(r.filter.name())),
             ("depth_range", r.depth_range != d.depth_range, depth(r.depth_range)),
             ("normals", r.normals != d.normals, r.normals.to_string()),
-            ("tonemap", r.tonemap != d.tonemap, string(tonemap_name(r.tonemap))),
+            ("tonemap", r.tonemap != d.tonemap, string(r.tonemap.name())),
             ("precision", r.precision != d.precision, string(r.precision.name())),
         ]);
         out
@@ -348,18 +347,4 @@ fn string(s: &str) -> String {
 fn key(name: &str) -> String {
     let bare = !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
     if bare { name.to_owned() } else { string(name) }
-}
-
-fn profile_name(profile: Profile) -> &'static str {
-    match profile {
-        Profile::Native => "native",
-        Profile::Mit6837 => "mit6837",
-    }
-}
-
-fn tonemap_name(tonemap: Tonemap) -> &'static str {
-    match tonemap {
-        Tonemap::Srgb => "srgb",
-        Tonemap::Clamp => "clamp",
-    }
 }

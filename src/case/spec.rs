@@ -5,8 +5,9 @@ use std::path::PathBuf;
 
 use glam::{DMat4, DVec3};
 
-use super::error::SourceLocation;
+use crate::compare::Tolerance;
 use crate::film::Tonemap;
+use crate::located_toml::SourceLocation;
 use crate::options::{Filter, Precision, Profile};
 
 /// One case file: a scene, how to render it, and how far it may drift from its golden image.
@@ -42,28 +43,6 @@ pub struct RenderSettings {
     pub tonemap: Tonemap,
     pub profile: Profile,
     pub precision: Precision,
-}
-
-/// How far a render may drift from golden; all values are non-negative.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Tolerance {
-    pub pixel: f64,
-    /// In [0, 1].
-    pub fail_fraction: f64,
-    pub rmse: f64,
-    /// A hard cap on any single channel's error, for cases where one wrong pixel matters.
-    pub max: Option<f64>,
-}
-
-impl Tolerance {
-    /// What a case without `[tolerance]` gets, and what `goldray diff` applies to two EXRs: one
-    /// definition, so the suite and the command judge alike.
-    pub const DEFAULT: Tolerance = Tolerance {
-        pixel: 0.01,
-        fail_fraction: 0.001,
-        rmse: 0.002,
-        max: None,
-    };
 }
 
 /// `direction` and `up` have nonzero length and are not parallel; `fov` is in (0, 180) degrees.

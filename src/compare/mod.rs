@@ -22,6 +22,7 @@ mod flip;
 mod heatmap;
 mod image;
 mod metrics;
+mod tolerance;
 mod verdict;
 
 pub use comparison::{Comparison, compare};
@@ -30,4 +31,5 @@ pub use files::{EXR_DEFAULTS, FileComparison, PNG_DEFAULTS, ToleranceOverrides, 
 pub use heatmap::{FAILING, NON_FINITE, diff_heatmap};
 pub use image::{COLOR_CHANNELS, Channel, Encoding, Image};
 pub use metrics::{ChannelStats, Metrics, NonFinite, PixelError};
+pub use tolerance::Tolerance;
 pub use verdict::{Breach, Layout, Limit, Verdict};

@@ -1,8 +1,6 @@
 //! The rendered image and its outputs: HDR colour plus the depth and normal AOVs, written as one
 //! linear EXR and as tone-mapped PNGs.
 
-use serde::Deserialize;
-
 mod error;
 mod exr;
 mod output;
@@ -46,12 +44,12 @@ impl Film {
     }
 }
 
-/// How linear colour becomes 8-bit PNG values.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Tonemap {
-    /// Clamp to [0, 1], apply the sRGB transfer curve, round to nearest.
-    Srgb,
-    /// The assignment's quantisation: `trunc(c·255)` clamped to [0, 255], no gamma.
-    Clamp,
+crate::named_enum::named_enum! {
+    /// How linear colour becomes 8-bit PNG values.
+    pub enum Tonemap: "tone map" {
+        /// Clamp to [0, 1], apply the sRGB transfer curve, round to nearest.
+        Srgb = "srgb",
+        /// The assignment's quantisation: `trunc(c·255)` clamped to [0, 255], no gamma.
+        Clamp = "clamp",
+    }
 }

@@ -10,8 +10,7 @@ use super::outcome::Outcome;
 use super::rubric::{ImageSpec, Rule};
 use super::submission::{Folder, read_png};
 use crate::atomic_write::write_file_atomic;
-use crate::case::Tolerance;
-use crate::compare::{Image, Metrics, compare, diff_heatmap};
+use crate::compare::{Image, Metrics, Tolerance, compare, diff_heatmap};
 use crate::film::{OutputError, encode_png, write_png};
 
 /// One expected file of one student.

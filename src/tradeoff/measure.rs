@@ -7,9 +7,10 @@ use std::time::{Duration, Instant};
 
 use super::error::TradeoffError;
 use super::setting::Setting;
-use crate::case::{Case, Tolerance};
-use crate::compare::{Image, compare};
+use crate::case::Case;
+use crate::compare::{Image, Tolerance, compare};
 use crate::film::Film;
+use crate::named_enum::named_enum;
 use crate::options::{Filter, Precision, RenderOptions};
 use crate::pipeline::render_options;
 use crate::precision::{double, single};
@@ -163,16 +164,18 @@ pub fn errors(reference: &Film, film: &Film, setting: &Setting) -> Result<Errors
     })
 }
 
-/// Which error the plot and the Pareto front rank settings by.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
-pub enum Metric {
-    /// RMSE on linear colour: its log-log slope against samples is the convergence rate
-    #[default]
-    Rmse,
-    /// The largest error of any colour channel of any pixel
-    Max,
-    /// The FLIP mean: what a viewer would notice
-    Flip,
+named_enum! {
+    /// Which error the plot and the Pareto front rank settings by; named as `--metric` names it.
+    #[derive(Default, clap::ValueEnum)]
+    pub enum Metric: "metric" {
+        /// RMSE on linear colour: its log-log slope against samples is the convergence rate
+        #[default]
+        Rmse = "rmse",
+        /// The largest error of any colour channel of any pixel
+        Max = "max",
+        /// The FLIP mean: what a viewer would notice
+        Flip = "flip",
+    }
 }
 
 impl Metric {
@@ -184,8 +187,8 @@ impl Metric {
         }
     }
 
-    /// The column name in the report and the flag's value.
-    pub fn name(self) -> &'static str {
+    /// The error's column in the report (`max_error` where the flag says `max`).
+    pub fn column(self) -> &'static str {
         match self {
             Metric::Rmse => "rmse",
             Metric::Max => "max_error",
