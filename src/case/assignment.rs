@@ -121,7 +121,7 @@ pub fn parse_assignment_scene(source: &str, path: &Path, options: &AssignmentOpt
         path: path.to_path_buf(),
         description: None,
         render,
-        tolerance: super::Tolerance::DEFAULT,
+        tolerance: crate::compare::Tolerance::DEFAULT,
         camera,
         background,
         lights,

@@ -21,20 +21,17 @@ pub use crate::located_toml::SourceLocation;
 pub use assignment::{AssignmentOptions, load_assignment_scene, parse_assignment_scene};
 pub use error::CaseError;
 pub use export::case_to_toml;
-pub use sections::{MAX_BOUNCES, MAX_IMAGE_SIZE};
+pub use sections::MAX_BOUNCES;
 pub use spec::{
     BackgroundSpec, CameraSpec, Case, LightSpec, MaterialSpec, ObjectSpec, RenderSettings, ShapeSpec, TransformOp,
     composite_matrix,
 };
 
-/// The comparator's settings, which a case's `[tolerance]` table fills in.
-pub use crate::compare::Tolerance;
-
 use crate::located_toml::{self, Doc, Table};
 
 #[derive(Clone, Debug, Default)]
 pub struct LoadOptions {
-    /// Lifts the `MAX_IMAGE_SIZE` guard (the CLI's `--force`).
+    /// Lifts the [`crate::image_size::MAX_IMAGE_SIZE`] guard (the CLI's `--force`).
     pub allow_huge_images: bool,
 }
 

@@ -11,12 +11,10 @@ use super::spec::{BackgroundSpec, CameraSpec, LightSpec, MaterialSpec, RenderSet
 use super::value::SceneValues;
 use crate::compare::Tolerance;
 use crate::film::Tonemap;
+use crate::image_size::{SizeLimit, check_side};
 use crate::located_toml::{Doc, Field, Result, Table};
 use crate::options::Profile;
 
-/// Beyond this a typo (an extra digit) is likelier than intent, and the film would need
-/// gigabytes; `--force` lifts it.
-pub const MAX_IMAGE_SIZE: i64 = 16384;
 /// Deeper recursion cannot change an 8-bit image and only risks runaway render times.
 pub const MAX_BOUNCES: i64 = 1024;
 /// Faces of a cube-map directory, as the assignment names them.
@@ -89,12 +87,12 @@ fn size(f: &Field, options: &LoadOptions) -> Result<(u32, u32)> {
     items[1].name = "height".to_owned();
     let mut out = [0; 2];
     for (slot, item) in out.iter_mut().zip(&items) {
-        *slot = if options.allow_huge_images {
-            item.integer_in(1..=i64::from(u32::MAX), "must be between 1 and 4294967295")?
+        let limit = if options.allow_huge_images {
+            SizeLimit::Lifted
         } else {
-            let requirement = format!("must be between 1 and {MAX_IMAGE_SIZE} (pass --force to render larger images)");
-            item.integer_in(1..=MAX_IMAGE_SIZE, &requirement)?
+            SizeLimit::Forceable
         };
+        *slot = check_side(item.integer()?, limit).map_err(|error| item.invalid(error.to_string()))?;
     }
     Ok((out[0], out[1]))
 }

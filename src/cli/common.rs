@@ -44,6 +44,16 @@ pub fn parse_fraction(text: &str) -> Result<f64, String> {
     }
 }
 
+/// A named option (`gaussian`, `f64`, `rmse`) through the option's own `FromStr`, whose error
+/// lists the valid names.
+pub fn parse_named<T>(text: &str) -> Result<T, String>
+where
+    T: std::str::FromStr,
+    T::Err: std::fmt::Display,
+{
+    text.trim().parse().map_err(|error: T::Err| error.to_string())
+}
+
 /// An image size as one argument, `WxH` (also `W×H`, `WXH`).
 pub fn parse_size(text: &str) -> Result<(u32, u32), String> {
     let usage = || format!("`{text}` is not a size: give WIDTHxHEIGHT, e.g. 64x48, or WIDTH HEIGHT");

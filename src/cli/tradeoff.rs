@@ -10,7 +10,7 @@ use goldray::options::{Filter, Precision};
 use goldray::tradeoff::{Metric, SweepPlan, TradeoffOptions, run_tradeoff, summary};
 
 use super::Failure;
-use super::common::{ThreadFlags, parse_size, parse_threshold};
+use super::common::{ThreadFlags, parse_named, parse_size, parse_threshold};
 use super::progress::Reporter;
 
 // The list defaults as the flags accept them (help shows them as written); a test checks they
@@ -38,11 +38,11 @@ pub struct TradeoffArgs {
           default_value = DEFAULT_SAMPLES)]
     pub samples: Vec<u32>,
     /// Filters of the grid: comma-separated, from none and gaussian (3× supersampling, 9× the rays).
-    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_filter,
+    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_named::<Filter>,
           default_value = DEFAULT_FILTER_LIST)]
     pub filters: Vec<Filter>,
     /// Precisions of the grid: comma-separated, from f32 and f64 (the reference is always f64).
-    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_precision,
+    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_named::<Precision>,
           default_value = DEFAULT_PRECISIONS)]
     pub precisions: Vec<Precision>,
     /// Render every setting and the reference at this size instead of the case's (e.g. 64x48):
@@ -67,8 +67,10 @@ pub struct TradeoffArgs {
     #[arg(long, value_name = "S", value_parser = parse_seconds,
           default_value_t = SweepPlan::default().min_time.as_secs_f64())]
     pub min_time: f64,
-    /// The error the plot and the Pareto front rank settings by.
-    #[arg(long, value_enum, default_value_t = Metric::Rmse)]
+    /// The error the plot and the Pareto front rank settings by: rmse (RMSE on linear colour; its
+    /// log-log slope against samples is the convergence rate), max (the largest error of any
+    /// channel of any pixel) or flip (the FLIP mean: what a viewer would notice).
+    #[arg(long, value_name = "METRIC", value_parser = parse_named::<Metric>, default_value = "rmse")]
     pub metric: Metric,
     #[command(flatten)]
     pub threads: ThreadFlags,
@@ -140,22 +142,6 @@ fn parse_square(text: &str) -> Result<u32, String> {
     Ok(n)
 }
 
-fn parse_filter(text: &str) -> Result<Filter, String> {
-    match text.trim() {
-        "none" => Ok(Filter::None),
-        "gaussian" => Ok(Filter::Gaussian),
-        other => Err(format!("`{other}` is not a filter: none or gaussian")),
-    }
-}
-
-fn parse_precision(text: &str) -> Result<Precision, String> {
-    let text = text.trim();
-    Precision::ALL
-        .into_iter()
-        .find(|p| p.name() == text)
-        .ok_or_else(|| format!("`{text}` is not a precision: f32 or f64"))
-}
-
 fn parse_flip(text: &str) -> Result<f64, String> {
     match text.trim().parse::<f64>() {
         Ok(x) if (0.0..=1.0).contains(&x) => Ok(x),
@@ -185,12 +171,12 @@ mod tests {
         assert_eq!(samples, SweepPlan::default().samples);
         let filters: Vec<Filter> = split(DEFAULT_FILTER_LIST)
             .iter()
-            .map(|s| parse_filter(s).unwrap())
+            .map(|s| parse_named::<Filter>(s).unwrap())
             .collect();
         assert_eq!(filters, DEFAULT_FILTERS);
         let precisions: Vec<Precision> = split(DEFAULT_PRECISIONS)
             .iter()
-            .map(|s| parse_precision(s).unwrap())
+            .map(|s| parse_named::<Precision>(s).unwrap())
             .collect();
         assert_eq!(precisions, Precision::ALL);
     }
@@ -201,10 +187,10 @@ mod tests {
         assert!(parse_square("8").unwrap_err().contains("nearest are 4 and 9"));
         assert!(parse_square("0").unwrap_err().contains("perfect square"));
         assert!(parse_square("four").unwrap_err().contains("whole number"));
-        assert_eq!(parse_filter("gaussian"), Ok(Filter::Gaussian));
-        assert!(parse_filter("box").unwrap_err().contains("none or gaussian"));
-        assert_eq!(parse_precision("f64"), Ok(Precision::F64));
-        assert!(parse_precision("f16").unwrap_err().contains("f32 or f64"));
+        assert_eq!(parse_named::<Filter>("gaussian"), Ok(Filter::Gaussian));
+        assert!(parse_named::<Filter>("box").unwrap_err().contains("none or gaussian"));
+        assert_eq!(parse_named::<Precision>("f64"), Ok(Precision::F64));
+        assert!(parse_named::<Precision>("f16").unwrap_err().contains("f32 or f64"));
         assert_eq!(parse_flip("0.05"), Ok(0.05));
         assert!(parse_flip("1.5").is_err() && parse_flip("nan").is_err());
         assert_eq!(parse_seconds("0"), Ok(0.0));

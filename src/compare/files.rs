@@ -7,21 +7,8 @@ use super::comparison::{Comparison, compare};
 use super::error::CompareError;
 use super::heatmap::diff_heatmap;
 use super::image::{Encoding, Image};
-use crate::case::Tolerance;
+use super::tolerance::{EXR_DEFAULTS, PNG_DEFAULTS, Tolerance};
 use crate::film::write_png;
-
-/// The case-file defaults, so that `goldray diff` on two EXRs judges like the golden suite.
-pub const EXR_DEFAULTS: Tolerance = Tolerance::DEFAULT;
-
-/// The same limits in 8-bit code values: an off-by-one code (rounding, or an ulp of drift at a
-/// quantisation boundary) is within `pixel`; `rmse` is 0.002 × 255 ≈ 0.5 codes, so a uniform
-/// one-code shift of the whole picture still fails.
-pub const PNG_DEFAULTS: Tolerance = Tolerance {
-    pixel: 1.0,
-    fail_fraction: 0.001,
-    rmse: 0.5,
-    max: None,
-};
 
 /// Limits given by the user; each one left out takes the default for the files' encoding.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -27,9 +27,9 @@ mod verdict;
 
 pub use comparison::{Comparison, compare};
 pub use error::CompareError;
-pub use files::{EXR_DEFAULTS, FileComparison, PNG_DEFAULTS, ToleranceOverrides, compare_files};
+pub use files::{FileComparison, ToleranceOverrides, compare_files};
 pub use heatmap::{FAILING, NON_FINITE, diff_heatmap};
 pub use image::{COLOR_CHANNELS, Channel, Encoding, Image};
 pub use metrics::{ChannelStats, Metrics, NonFinite, PixelError};
-pub use tolerance::Tolerance;
+pub use tolerance::{EXR_DEFAULTS, PNG_DEFAULTS, Tolerance};
 pub use verdict::{Breach, Layout, Limit, Verdict};

@@ -24,3 +24,16 @@ impl Tolerance {
         max: None,
     };
 }
+
+/// The case-file defaults, so that `goldray diff` on two EXRs judges like the golden suite.
+pub const EXR_DEFAULTS: Tolerance = Tolerance::DEFAULT;
+
+/// The same limits in 8-bit code values: an off-by-one code (rounding, or an ulp of drift at a
+/// quantisation boundary) is within `pixel`; `rmse` is 0.002 × 255 ≈ 0.5 codes, so a uniform
+/// one-code shift of the whole picture still fails.
+pub const PNG_DEFAULTS: Tolerance = Tolerance {
+    pixel: 1.0,
+    fail_fraction: 0.001,
+    rmse: 0.5,
+    max: None,
+};

@@ -37,7 +37,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use rayon::prelude::*;
 
 use crate::progress::Progress;
-pub use error::GradeError;
+pub use error::{GradeError, RubricError};
 pub use golden::{GoldenRender, Goldens, default_cache_dir, prepare_goldens};
 pub use outcome::Outcome;
 pub use report::{ClassReport, RubricSummary};

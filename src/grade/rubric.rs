@@ -9,7 +9,8 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use super::error::RubricError;
-use crate::case::{self, AssignmentOptions, Case, LoadOptions, MAX_BOUNCES, MAX_IMAGE_SIZE, load_assignment_scene};
+use crate::case::{self, AssignmentOptions, Case, LoadOptions, MAX_BOUNCES, load_assignment_scene};
+use crate::image_size::{MAX_IMAGE_SIZE, SizeLimit, check_side};
 use crate::located_toml::{self, Doc, Field, SourceLocation, Table, suggest};
 use crate::named_enum::named_enum;
 
@@ -182,7 +183,7 @@ fn render_source(entry: &Field) -> Result<RenderSource> {
     let location = doc.location(entry.key_span.start);
     let size = table.read("size", None, |f| {
         let [w, h] = f.numbers::<2>("an array [width, height]")?;
-        let side = |v: f64| v.fract() == 0.0 && (1.0..=MAX_IMAGE_SIZE as f64).contains(&v);
+        let side = |v: f64| v.fract() == 0.0 && check_side(v as i64, SizeLimit::Fixed).is_ok();
         if side(w) && side(h) {
             Ok(Some((w as u32, h as u32)))
         } else {

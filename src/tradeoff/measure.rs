@@ -166,7 +166,7 @@ pub fn errors(reference: &Film, film: &Film, setting: &Setting) -> Result<Errors
 
 named_enum! {
     /// Which error the plot and the Pareto front rank settings by; named as `--metric` names it.
-    #[derive(Default, clap::ValueEnum)]
+    #[derive(Default)]
     pub enum Metric: "metric" {
         /// RMSE on linear colour: its log-log slope against samples is the convergence rate
         #[default]

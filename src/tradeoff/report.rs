@@ -278,7 +278,7 @@ pub fn summary(t: &Tradeoff) -> String {
                 "{} ({} s, {} {})",
                 m.setting.label(),
                 significant(m.seconds),
-                t.metric.name(),
+                t.metric.column(),
                 significant(t.metric.of(&m.errors))
             )
         })

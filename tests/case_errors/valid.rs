@@ -1,8 +1,7 @@
 //! A full case parses to exactly the expected values, and omitted settings get their defaults.
 
-use goldray::case::{
-    BackgroundSpec, CameraSpec, LightSpec, LoadOptions, MaterialSpec, ShapeSpec, Tolerance, TransformOp, load,
-};
+use goldray::case::{BackgroundSpec, CameraSpec, LightSpec, LoadOptions, MaterialSpec, ShapeSpec, TransformOp, load};
+use goldray::compare::Tolerance;
 use goldray::film::Tonemap;
 use goldray::options::{Filter, Profile};
 
