@@ -216,11 +216,7 @@ const COURSE_COMMANDS: [(&str, (f64, f64), u32, bool); 7] = [
 ];
 
 fn course_scenes(c: &mut Criterion) {
-    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/mit6837/data");
-    assert!(
-        data.is_dir(),
-        "../shared/mit6837 is missing: the course benchmark needs its scenes"
-    );
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/mit6837");
     let mut group = c.benchmark_group("course_scenes");
     group.sample_size(10);
     group.bench_function("seven_at_800", |b| {

@@ -32,15 +32,9 @@ const SCENES: [&str; 7] = [
     "scene07_arch.txt",
 ];
 
-/// The course data is shared, not vendored; its absence must fail loudly, never skip.
+/// The course's scenes, with their `models/` and `tex/`.
 fn data_dir() -> PathBuf {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/mit6837/data");
-    assert!(
-        dir.join("models/cube2.obj").is_file(),
-        "../shared/mit6837 is missing: the course scenes must be at {}",
-        dir.display()
-    );
-    dir
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/mit6837")
 }
 
 fn course_scene(name: &str) -> Case {

@@ -66,11 +66,6 @@ fn rubric_mistakes_are_located_and_explained() {
 
 #[test]
 fn the_shipped_course_rubric_grades_the_21_images_of_the_seven_commands() {
-    let shared = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/mit6837");
-    assert!(
-        shared.is_dir(),
-        "../shared/mit6837 is missing: the course rubric reads its scenes"
-    );
     let rubric = load_rubric(&Path::new(env!("CARGO_MANIFEST_DIR")).join("rubrics/mit6837.toml"))
         .unwrap_or_else(|e| panic!("{e}"));
     let files: Vec<&str> = rubric.images.iter().map(|i| i.file.as_str()).collect();
