@@ -29,7 +29,7 @@ use goldray::geometry::aabb::Aabb;
 use goldray::geometry::bvh::Bvh;
 use goldray::geometry::generate::{blob, write_obj};
 use goldray::geometry::mesh::{Mesh, VertexNormals};
-use goldray::options::{Filter, Profile, RenderOptions, Spawn};
+use goldray::options::{Filter, Profile, RenderOptions, Spawn, Trace};
 use goldray::pipeline::{render_case, render_options};
 use goldray::progress::Silent;
 use goldray::real::{Color, Real, Vec3};
@@ -81,13 +81,15 @@ fn blob_scene_lit(lights: Vec<Light>) -> Scene {
 
 fn primary_rays(c: &mut Criterion) {
     let options = RenderOptions {
-        width: SIDE,
-        height: SIDE,
-        bounces: 0,
-        shadows: false,
-        samples: 1,
-        seed: 0,
-        filter: Filter::None,
+        trace: Trace {
+            width: SIDE,
+            height: SIDE,
+            bounces: 0,
+            shadows: false,
+            samples: 1,
+            seed: 0,
+            filter: Filter::None,
+        },
         spawn: Spawn::ErrorBounds,
         aovs: true,
     };
@@ -295,13 +297,15 @@ fn only_what_is_required(c: &mut Criterion) {
         falloff: 0.05,
     };
     let options = |shadows, samples, aovs| RenderOptions {
-        width: SIDE,
-        height: SIDE,
-        bounces: 0,
-        shadows,
-        samples,
-        seed: 0,
-        filter: Filter::None,
+        trace: Trace {
+            width: SIDE,
+            height: SIDE,
+            bounces: 0,
+            shadows,
+            samples,
+            seed: 0,
+            filter: Filter::None,
+        },
         spawn: Spawn::ErrorBounds,
         aovs,
     };

@@ -52,15 +52,25 @@ pub enum Spawn {
     FixedEpsilon(f64),
 }
 
+/// What a render traces: the part a case's `[render]` table and the renderer's options share,
+/// defined once so that the two cannot drift apart.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RenderOptions {
+pub struct Trace {
     pub width: u32,
     pub height: u32,
     pub bounces: u32,
     pub shadows: bool,
+    /// Per pixel (per sub-pixel with the Gaussian filter); a perfect square, so that stratified
+    /// jitter can use an n×n grid.
     pub samples: u32,
     pub seed: u64,
     pub filter: Filter,
+}
+
+/// What the renderer is asked to do: the trace, plus what a case file cannot choose.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RenderOptions {
+    pub trace: Trace,
     pub spawn: Spawn,
     /// Whether anything reads the depth and normal AOVs. Without them no ray is traced for
     /// them and the film's `depth` and `normal` stay as [`crate::film::Film::new`] made them:

@@ -34,7 +34,7 @@ pub fn render_case_reporting(case: &Case, progress: &dyn Progress) -> Result<Fil
 
 /// Brackets one render in `begin`/`finish`, counting its rows.
 fn rendering<T>(case: &Case, progress: &dyn Progress, render: impl FnOnce(&dyn Progress) -> T) -> T {
-    progress.begin(&case.name, u64::from(case.render.height));
+    progress.begin(&case.name, u64::from(case.render.trace.height));
     let result = render(progress);
     progress.finish();
     result
@@ -68,15 +68,8 @@ pub struct MeasuredRender {
 /// The renderer's options from a case's `[render]` table. A case's render always writes the
 /// EXR, whose `Z` and `N` channels are the AOVs, so they are always traced.
 pub fn render_options(case: &Case) -> RenderOptions {
-    let settings = &case.render;
     RenderOptions {
-        width: settings.width,
-        height: settings.height,
-        bounces: settings.bounces,
-        shadows: settings.shadows,
-        samples: settings.samples,
-        seed: settings.seed,
-        filter: settings.filter,
+        trace: case.render.trace,
         spawn: Spawn::ErrorBounds,
         aovs: true,
     }
@@ -148,7 +141,7 @@ fn measured_run(
     };
     let stats = RenderStats::new(
         &case.name,
-        (case.render.width, case.render.height),
+        (case.render.trace.width, case.render.trace.height),
         phases,
         measured.build_stats,
         &measured.rays,

@@ -134,7 +134,7 @@ fn fails_a_one_pixel_shift_of_the_edges() {
 fn fails_a_missing_shadow() {
     let with = case("spheres_shadows");
     let mut without = with.clone();
-    without.render.shadows = false;
+    without.render.trace.shadows = false;
     let comparison = judge(&render(&with), &render(&without), &with.tolerance);
     assert_fails_on(&comparison, Limit::FailFraction);
     assert_fails_on(&comparison, Limit::Rmse);
@@ -210,7 +210,7 @@ fn an_infinite_colour_fails_but_a_depth_that_turns_into_a_miss_is_only_a_failing
 fn reports_a_size_change_as_a_mismatch() {
     let golden = case("directional_light");
     let mut wider = golden.clone();
-    wider.render.width += 1;
+    wider.render.trace.width += 1;
     let comparison = judge(&render(&golden), &render(&wider), &EXR_DEFAULTS);
     assert!(matches!(comparison.verdict, Verdict::Mismatch { .. }), "{comparison}");
     assert_eq!(comparison.verdict.exit_code(), 3);

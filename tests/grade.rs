@@ -330,8 +330,8 @@ fn a_wide_class_table_keeps_names_and_lost_points_on_screen() {
     let rubric_path = dir.path().join("wide.toml");
     fs::write(&rubric_path, rubric).unwrap();
     let mut case = goldray::case::load(&scene, &goldray::case::LoadOptions::default()).unwrap();
-    case.render.width = 64;
-    case.render.height = 64;
+    case.render.trace.width = 64;
+    case.render.trace.height = 64;
     let png = encode_png(&color_image(
         &goldray::pipeline::render_case(&case).unwrap(),
         Tonemap::Clamp,

@@ -95,18 +95,34 @@ impl Writer<'_> {
         let mut out = format!(
             "\n[render]\nprofile = {}\nsize = [{}, {}]\n",
             string(r.profile.name()),
-            r.width,
-            r.height
+            r.trace.width,
+            r.trace.height
         );
         let depth = |range: Option<(f64, f64)>| {
             range.map_or_else(String::new, |(min, max)| format!("[{}, {}]", number(min), number(max)))
         };
         out += &only_changed(&[
-            ("bounces", r.bounces != d.bounces, r.bounces.to_string()),
-            ("shadows", r.shadows != d.shadows, r.shadows.to_string()),
-            ("samples", r.samples != d.samples, r.samples.to_string()),
-            ("seed", r.seed != d.seed, r.seed.to_string()),
-            ("filter", r.filter != d.filter, string(r.filter.name())),
+            (
+                "bounces",
+                r.trace.bounces != d.trace.bounces,
+                r.trace.bounces.to_string(),
+            ),
+            (
+                "shadows",
+                r.trace.shadows != d.trace.shadows,
+                r.trace.shadows.to_string(),
+            ),
+            (
+                "samples",
+                r.trace.samples != d.trace.samples,
+                r.trace.samples.to_string(),
+            ),
+            ("seed", r.trace.seed != d.trace.seed, r.trace.seed.to_string()),
+            (
+                "filter",
+                r.trace.filter != d.trace.filter,
+                string(r.trace.filter.name()),
+            ),
             ("depth_range", r.depth_range != d.depth_range, depth(r.depth_range)),
             ("normals", r.normals != d.normals, r.normals.to_string()),
             ("tonemap", r.tonemap != d.tonemap, string(r.tonemap.name())),

@@ -13,7 +13,7 @@ use crate::compare::Tolerance;
 use crate::film::Tonemap;
 use crate::image_size::{SizeLimit, check_side};
 use crate::located_toml::{Doc, Field, Result, Table};
-use crate::options::Profile;
+use crate::options::{Profile, Trace};
 
 /// Deeper recursion cannot change an 8-bit image and only risks runaway render times.
 pub const MAX_BOUNCES: i64 = 1024;
@@ -53,15 +53,17 @@ pub(crate) fn render<'a>(
         Profile::Mit6837 => Tonemap::Clamp,
     };
     Ok(RenderSettings {
-        width,
-        height,
-        bounces: t.read("bounces", 0, |f| {
-            f.integer_in(0..=MAX_BOUNCES, &format!("must be between 0 and {MAX_BOUNCES}"))
-        })?,
-        shadows: t.read("shadows", false, Field::boolean)?,
-        samples: t.read("samples", 1, samples)?,
-        seed: t.read("seed", 0, |f| f.integer_in(0..=i64::MAX, "must be ≥ 0"))?,
-        filter: t.read("filter", Default::default(), Field::variant)?,
+        trace: Trace {
+            width,
+            height,
+            bounces: t.read("bounces", 0, |f| {
+                f.integer_in(0..=MAX_BOUNCES, &format!("must be between 0 and {MAX_BOUNCES}"))
+            })?,
+            shadows: t.read("shadows", false, Field::boolean)?,
+            samples: t.read("samples", 1, samples)?,
+            seed: t.read("seed", 0, |f| f.integer_in(0..=i64::MAX, "must be ≥ 0"))?,
+            filter: t.read("filter", Default::default(), Field::variant)?,
+        },
         depth_range: t.read("depth_range", None, |f| {
             let [min, max] = f.numbers("an array of 2 numbers [min, max]")?;
             if min < max {

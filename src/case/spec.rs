@@ -8,7 +8,7 @@ use glam::{DMat4, DVec3};
 use crate::compare::Tolerance;
 use crate::film::Tonemap;
 use crate::located_toml::SourceLocation;
-use crate::options::{Filter, Precision, Profile};
+use crate::options::{Precision, Profile, Trace};
 
 /// One case file: a scene, how to render it, and how far it may drift from its golden image.
 #[derive(Clone, Debug, PartialEq)]
@@ -29,14 +29,7 @@ pub struct Case {
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
-    pub width: u32,
-    pub height: u32,
-    pub bounces: u32,
-    pub shadows: bool,
-    /// Always a perfect square, so stratified jitter can use an n×n grid.
-    pub samples: u32,
-    pub seed: u64,
-    pub filter: Filter,
+    pub trace: Trace,
     /// `(min, max)` with `min < max`, mapped to black..white in the depth PNG.
     pub depth_range: Option<(f64, f64)>,
     pub normals: bool,

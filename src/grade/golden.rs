@@ -138,7 +138,7 @@ pub fn prepare_goldens(
 fn read_cached(path: &Path, case: &Case) -> Option<Film> {
     let bytes = fs::read(path).ok()?;
     let film = decode_exr(&bytes).ok()?;
-    (film.width == case.render.width && film.height == case.render.height).then_some(film)
+    (film.width == case.render.trace.width && film.height == case.render.trace.height).then_some(film)
 }
 
 fn store(path: &Path, film: &Film) -> Result<(), String> {

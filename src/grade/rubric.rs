@@ -206,8 +206,8 @@ fn render_source(entry: &Field) -> Result<RenderSource> {
             let path = doc.dir.join(case_field.string()?);
             case::load(&path, &LoadOptions::default()).map(|mut case| {
                 if let Some((width, height)) = size {
-                    case.render.width = width;
-                    case.render.height = height;
+                    case.render.trace.width = width;
+                    case.render.trace.height = height;
                 }
                 case
             })

@@ -75,7 +75,7 @@ impl<'a> Renderer<'a> {
     }
 
     pub fn pixels(&self) -> u64 {
-        u64::from(self.case.render.width) * u64::from(self.case.render.height)
+        u64::from(self.case.render.trace.width) * u64::from(self.case.render.trace.height)
     }
 
     /// Renders `setting`, again and again until the runs add up to `min_time` (at most
@@ -113,7 +113,7 @@ impl<'a> Renderer<'a> {
     /// same seed a setting's samples would partly repeat the reference's and its error would look
     /// smaller than it is.
     pub fn reference(&self, samples: u32, bounces: u32) -> Reference {
-        let seed = self.case.render.seed.wrapping_add(1);
+        let seed = self.case.render.trace.seed.wrapping_add(1);
         let precision = REFERENCE_PRECISION;
         let mut case = Setting {
             samples,
@@ -122,7 +122,7 @@ impl<'a> Renderer<'a> {
             precision,
         }
         .apply(self.case);
-        case.render.seed = seed;
+        case.render.trace.seed = seed;
         let start = Instant::now();
         let (film, rays) = self.render_once(precision, &render_options(&case));
         Reference {

@@ -171,8 +171,8 @@ pub fn measure_tradeoff(
     plan.validate()?;
     let mut case = case.clone();
     if let Some((width, height)) = plan.size {
-        case.render.width = width;
-        case.render.height = height;
+        case.render.trace.width = width;
+        case.render.trace.height = height;
     }
     let sweep = run_sweep(&case, plan, progress);
     progress.finish();
@@ -194,8 +194,8 @@ pub fn measure_tradeoff(
     Ok(Tradeoff {
         case_name: case.name.clone(),
         case_path: case.path.clone(),
-        width: case.render.width,
-        height: case.render.height,
+        width: case.render.trace.width,
+        height: case.render.trace.height,
         base: Setting::of(&case),
         threads: rayon::current_num_threads(),
         min_time: plan.min_time,

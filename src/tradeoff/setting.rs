@@ -18,9 +18,9 @@ impl Setting {
     /// The setting the case file itself asks for.
     pub fn of(case: &Case) -> Setting {
         Setting {
-            samples: case.render.samples,
-            filter: case.render.filter,
-            bounces: case.render.bounces,
+            samples: case.render.trace.samples,
+            filter: case.render.trace.filter,
+            bounces: case.render.trace.bounces,
             precision: case.render.precision,
         }
     }
@@ -49,9 +49,9 @@ impl Setting {
     /// The case with this setting in its `[render]` table.
     pub fn apply(&self, case: &Case) -> Case {
         let mut case = case.clone();
-        case.render.samples = self.samples;
-        case.render.filter = self.filter;
-        case.render.bounces = self.bounces;
+        case.render.trace.samples = self.samples;
+        case.render.trace.filter = self.filter;
+        case.render.trace.bounces = self.bounces;
         case.render.precision = self.precision;
         case
     }
