@@ -49,7 +49,7 @@ pub fn normals_image(film: &Film, tonemap: Tonemap) -> RgbImage {
 /// outside, NaN included, is tolerated) and each is quantised by the tone map's rule. A film whose
 /// buffers are shorter than its size shows the missing pixels as misses rather than panicking;
 /// the EXR encoder is what rejects such a film.
-fn quantised_image(film: &Film, tonemap: Tonemap, value: impl Fn(usize) -> [f32; 3]) -> RgbImage {
+pub(super) fn quantised_image(film: &Film, tonemap: Tonemap, value: impl Fn(usize) -> [f32; 3]) -> RgbImage {
     RgbImage::from_fn(film.width, film.height, |x, y| {
         Rgb(value(film.index(x, y)).map(|v| quantise(v, tonemap)))
     })

@@ -40,6 +40,11 @@ impl Aggregate {
         &self.objects
     }
 
+    /// The infinite planes, tested beside the BVH, with their materials.
+    pub fn planes(&self) -> &[(Plane, u32)] {
+        &self.planes
+    }
+
     pub fn bvh(&self) -> Option<&Bvh> {
         self.bvh.as_ref()
     }
