@@ -42,6 +42,7 @@ fn graded() -> &'static Graded {
         let options = GradeOptions {
             out: out.clone(),
             cache: None,
+            diagnose: true,
         };
         let started = Instant::now();
         let report =
@@ -351,6 +352,7 @@ fn a_wide_class_table_keeps_names_and_lost_points_on_screen() {
     let options = GradeOptions {
         out: out.clone(),
         cache: Some(dir.path().join("cache")),
+        diagnose: true,
     };
     let report = grade_class(&rubric_path, &dir.path().join("submissions"), &options, &Silent).unwrap();
     assert_eq!(student(&report, "bob").images[20].outcome, Outcome::Missing);

@@ -28,6 +28,9 @@ pub struct GradeArgs {
     /// No progress and no summary.
     #[arg(long)]
     quiet: bool,
+    /// Do not name the mistake behind each image that lost points (faster: no fault renders).
+    #[arg(long)]
+    no_diagnose: bool,
 }
 
 pub fn run(args: GradeArgs) -> Result<ExitCode, Failure> {
@@ -35,6 +38,7 @@ pub fn run(args: GradeArgs) -> Result<ExitCode, Failure> {
     let options = GradeOptions {
         out: args.out.clone(),
         cache: args.cache.clone(),
+        diagnose: !args.no_diagnose,
     };
     let reporter = Reporter::new(args.quiet);
     let report = args

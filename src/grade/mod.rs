@@ -11,7 +11,7 @@
 //! use goldray::grade::{GradeOptions, grade_class};
 //! # fn main() -> Result<(), goldray::grade::GradeError> {
 //! use goldray::progress::Silent;
-//! let options = GradeOptions { out: "report".into(), cache: None };
+//! let options = GradeOptions::new("report");
 //! let report = grade_class("rubrics/mit6837.toml".as_ref(), "submissions".as_ref(), &options, &Silent)?;
 //! for student in &report.students {
 //!     println!("{}: {} / {}", student.name, student.total, student.max_points);
@@ -20,6 +20,7 @@
 //! # }
 //! ```
 
+mod diagnose;
 mod error;
 mod golden;
 mod html;
@@ -37,6 +38,10 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use rayon::prelude::*;
 
 use crate::progress::Progress;
+pub use diagnose::{
+    Closest, Confidence, Diagnosis, DiagnosisRun, FAILING_REDUCTION, MISTAKES_DIR, RMSE_REDUCTION, RenderDiagnosis,
+    Residual, UNEXPLAINED, explains, loses_points,
+};
 pub use error::{GradeError, RubricError};
 pub use golden::{GoldenRender, Goldens, default_cache_dir, prepare_goldens};
 pub use outcome::Outcome;
@@ -44,12 +49,25 @@ pub use report::{ClassReport, RubricSummary};
 pub use rubric::{ImageSpec, Output, RenderSource, Rubric, Rule, load_rubric, parse_rubric};
 pub use score::{ImageResult, StudentResult, Submission, grade_image, judge};
 
-/// Where the report and the golden cache go.
+/// Where the report and the golden cache go, and whether to diagnose.
 #[derive(Clone, Debug)]
 pub struct GradeOptions {
     pub out: PathBuf,
     /// `None`: [`default_cache_dir`].
     pub cache: Option<PathBuf>,
+    /// Name the mistake behind each image that lost points (see [`Diagnosis`]).
+    pub diagnose: bool,
+}
+
+impl GradeOptions {
+    /// A report in `out`, the default cache, with diagnosis.
+    pub fn new(out: impl Into<PathBuf>) -> GradeOptions {
+        GradeOptions {
+            out: out.into(),
+            cache: None,
+            diagnose: true,
+        }
+    }
 }
 
 /// Loads the rubric, prepares the goldens, grades every student folder of `submissions` on the
@@ -96,10 +114,22 @@ pub fn grade_class(
         .collect::<Result<Vec<_>, _>>()?;
     progress.finish();
     let mut results = results.into_iter();
-    let students = folders
+    let mut students: Vec<StudentResult> = folders
         .iter()
         .map(|submission| StudentResult::new(submission, results.by_ref().take(per_student).collect()))
         .collect();
+    let diagnosis = if options.diagnose {
+        Some(diagnose::diagnose_class(
+            &rubric,
+            &goldens,
+            &cache,
+            &mut students,
+            out,
+            progress,
+        )?)
+    } else {
+        None
+    };
 
     let report = ClassReport {
         goldray: env!("CARGO_PKG_VERSION"),
@@ -107,6 +137,7 @@ pub fn grade_class(
         submissions: submissions.to_path_buf(),
         cache: cache.clone(),
         goldens: goldens.renders,
+        diagnosis,
         ignored,
         students,
     };

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
+use super::diagnose::DiagnosisRun;
 use super::golden::GoldenRender;
 use super::rubric::{ImageSpec, Rubric};
 use super::score::StudentResult;
@@ -22,6 +23,8 @@ pub struct ClassReport {
     /// Where the golden renders were cached.
     pub cache: PathBuf,
     pub goldens: Vec<GoldenRender>,
+    /// What diagnosing the images that lost points cost; `None` when grading did not diagnose.
+    pub diagnosis: Option<DiagnosisRun>,
     /// Entries of the submissions folder that are not student folders (loose files), by name.
     pub ignored: Vec<String>,
     /// By folder name.

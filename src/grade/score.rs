@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
+use super::diagnose::Diagnosis;
 use super::golden::GOLDEN_DIR;
 use super::outcome::Outcome;
 use super::rubric::{ImageSpec, Rule};
@@ -32,6 +33,10 @@ pub struct ImageResult {
     /// The diff heatmap, relative to the report directory.
     pub diff_image: Option<String>,
     pub metrics: Option<Metrics>,
+    /// Which mistake explains the image, only for an image that lost points on a comparison
+    /// (and only when grading diagnoses).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub diagnosis: Option<Diagnosis>,
 }
 
 /// All of one student's results, in rubric order.
@@ -85,6 +90,11 @@ impl StudentResult {
             images,
         }
     }
+
+    /// The total again, after points changed (credit for a diagnosed mistake).
+    pub fn recount(&mut self) {
+        self.total = self.images.iter().map(|i| i.points).sum();
+    }
 }
 
 /// Grades one expected image of one submission against its golden picture, writing the student's
@@ -108,6 +118,7 @@ pub fn grade_image(
         student_image: None,
         diff_image: None,
         metrics: None,
+        diagnosis: None,
     };
     let located = match (&folder.error, folder.find(&spec.file)) {
         (Some(reason), _) => return Ok(refused(result, Outcome::Unreadable { reason: reason.clone() })),

@@ -3,14 +3,19 @@
 //! case, those of the integrator are handed to the renderer, and those of the PNGs are left to
 //! [`crate::film::picture_with_faults`].
 
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
+
 use glam::DVec3;
 
 use super::{render_options, rendering};
 use crate::case::{Case, LightSpec, ObjectSpec, ShapeSpec};
 use crate::error::Error;
-use crate::fault::{Fault, FaultSet, Mapping};
+use crate::fault::{Fault, FaultSet, Injection, Mapping};
 use crate::film::Film;
-use crate::progress::Progress;
+use crate::options::Precision;
+use crate::precision::{double, single};
+use crate::progress::{Progress, Silent};
 use crate::with_precision;
 
 /// The film a program with `faults` renders for `case` (its PNG faults aside). With no fault
@@ -22,6 +27,56 @@ pub fn render_case_with_faults(case: &Case, faults: &FaultSet, progress: &dyn Pr
         let scene = p::scene::build_scene(&case)?;
         Ok(rendering(&case, progress, |progress| p::render::render_with_faults(&scene, &options, *faults, progress)))
     })
+}
+
+/// Renders one case under many fault sets, building each scene once: the faults that act on
+/// the integrator or the render settings share the golden scene (its meshes, BVHs and cube
+/// map), and each distinct change of the description gets its own.
+pub struct FaultRenderer {
+    case: Case,
+    scenes: Mutex<HashMap<String, Arc<Built>>>,
+}
+
+enum Built {
+    Single(single::scene::Scene),
+    Double(double::scene::Scene),
+}
+
+impl FaultRenderer {
+    pub fn new(case: &Case) -> FaultRenderer {
+        FaultRenderer {
+            case: case.clone(),
+            scenes: Mutex::new(HashMap::new()),
+        }
+    }
+
+    /// [`render_case_with_faults`], without progress.
+    pub fn render(&self, faults: &FaultSet) -> Result<Film, Error> {
+        let case = case_with_faults(&self.case, faults);
+        let options = render_options(&case);
+        let scene = self.scene(&case, faults)?;
+        Ok(match &*scene {
+            Built::Single(scene) => single::render::render_with_faults(scene, &options, *faults, &Silent),
+            Built::Double(scene) => double::render::render_with_faults(scene, &options, *faults, &Silent),
+        })
+    }
+
+    fn scene(&self, case: &Case, faults: &FaultSet) -> Result<Arc<Built>, Error> {
+        let key = faults.only(Injection::Case).to_string();
+        if let Some(scene) = self.lock().get(&key) {
+            return Ok(scene.clone());
+        }
+        let built = Arc::new(match case.render.precision {
+            Precision::F32 => Built::Single(single::scene::build_scene(case)?),
+            Precision::F64 => Built::Double(double::scene::build_scene(case)?),
+        });
+        self.lock().insert(key, built.clone());
+        Ok(built)
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, HashMap<String, Arc<Built>>> {
+        self.scenes.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
 }
 
 /// The case as the faulty program understands it: the faults that change the description
