@@ -227,8 +227,18 @@ fn transformed_triangle(
 ) -> Result<Triangle, TransformError> {
     let matrix = matrix.unwrap_or(DMat4::IDENTITY);
     let inverse_transpose = inverse_linear(matrix)?.transpose();
-    let vertices = vertices.map(|v| vec3(matrix.transform_point3(DVec3::from(v)).to_array()));
-    let normals = normals.map(|ns| ns.map(|n| vec3((inverse_transpose * DVec3::from(n)).normalize_or_zero().to_array())));
+    let mut vertices = vertices.map(|v| vec3(matrix.transform_point3(DVec3::from(v)).to_array()));
+    let mut normals =
+        normals.map(|ns| ns.map(|n| vec3((inverse_transpose * DVec3::from(n)).normalize_or_zero().to_array())));
+    // A mirroring matrix reverses the winding, and with it the face normal taken from the moved
+    // vertices; swapping two vertices keeps the face normal the inverse transpose's, as for an
+    // instanced mesh and in the course's reference renderer.
+    if glam::DMat3::from_mat4(matrix).determinant() < 0.0 {
+        vertices.swap(1, 2);
+        if let Some(normals) = &mut normals {
+            normals.swap(1, 2);
+        }
+    }
     Ok(Triangle { vertices, normals })
 }
 
