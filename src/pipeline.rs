@@ -7,7 +7,7 @@ use crate::assignment_outputs::AssignmentOutputs;
 use crate::case::{self, AssignmentOptions, Case, LoadOptions, case_to_toml, load_assignment_scene};
 use crate::error::Error;
 use crate::film::{Film, OutputOptions, write_outputs};
-use crate::options::{RenderOptions, Spawn};
+use crate::options::{Profile, RenderOptions, Spawn};
 use crate::progress::Progress;
 use crate::stats::{BuildStats, Phases, RayCounts, RenderStats};
 use crate::with_precision;
@@ -64,7 +64,10 @@ pub fn render_options(case: &Case) -> RenderOptions {
         samples: settings.samples,
         seed: settings.seed,
         filter: settings.filter,
-        spawn: Spawn::ErrorBounds,
+        spawn: match settings.profile {
+            Profile::Native => Spawn::ErrorBounds,
+            Profile::Mit6837 => Spawn::Course,
+        },
         aovs: true,
     }
 }

@@ -39,12 +39,16 @@ impl<'a> Whitted<'a> {
             }
             let material = &scene.materials[hit.material as usize];
             color += throughput * self.direct_light(&ray, &hit, rays);
-            if depth == self.bounces || !material.reflects() {
+            let mirror = match self.spawn {
+                Spawn::Course => f64::from(material.specular.length()) > Spawn::COURSE_MIRROR_THRESHOLD,
+                _ => material.reflects(),
+            };
+            if depth == self.bounces || !mirror {
                 break;
             }
             throughput *= material.specular;
             let normal = hit.surface.shading_normal;
-            let incoming = ray.direction.normalize();
+            let incoming = self.view(ray.direction);
             let reflected = incoming - 2.0 * incoming.dot(normal) * normal;
             ray = spawn(self.spawn, &hit.surface, reflected);
             rays.reflection += 1;
@@ -57,7 +61,7 @@ impl<'a> Whitted<'a> {
         let scene = self.scene;
         let material = &scene.materials[hit.material as usize];
         let surface = &hit.surface;
-        let to_eye = -ray.direction.normalize();
+        let to_eye = -self.view(ray.direction);
         let mut color = scene.ambient * material.diffuse;
         for light in &scene.lights {
             let incident = light.incident(surface.point);
@@ -70,6 +74,16 @@ impl<'a> Whitted<'a> {
             color += material.shade(surface.shading_normal, incident.to_light, to_eye, incident.intensity);
         }
         color
+    }
+
+    /// The direction a ray travels in, for reflecting and for the highlight: unit length, except
+    /// that the course uses it as computed (longer or shorter after one of its planes with a
+    /// non-unit normal).
+    fn view(&self, direction: Vec3) -> Vec3 {
+        match self.spawn {
+            Spawn::Course => direction,
+            _ => direction.normalize(),
+        }
     }
 
     fn blocked(&self, hit: &Intersection, to_light: Vec3, position: Option<Vec3>) -> bool {
