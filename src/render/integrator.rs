@@ -40,7 +40,8 @@ impl<'a> Whitted<'a> {
             let material = &scene.materials[hit.material as usize];
             color += throughput * self.direct_light(&ray, &hit, rays);
             let mirror = match self.spawn {
-                Spawn::Course => f64::from(material.specular.length()) > Spawn::COURSE_MIRROR_THRESHOLD,
+                // Compared as the course does: its float length widened to double, against 0.1.
+                Spawn::Course => (material.specular.length() as f64) > Spawn::COURSE_MIRROR_THRESHOLD,
                 _ => material.reflects(),
             };
             if depth == self.bounces || !mirror {
