@@ -9,6 +9,13 @@ mod errors;
 mod export;
 #[path = "assignment_scenes/fuzz.rs"]
 mod fuzz;
+/// The differential test's scene generator, to check here that goldray takes what it writes.
+/// Only the driver reads a scene's image size, depth range and bounces.
+#[path = "../examples/course_diff/generate.rs"]
+#[allow(dead_code)]
+mod generate;
+#[path = "assignment_scenes/reference.rs"]
+mod reference;
 #[path = "assignment_scenes/syntax.rs"]
 mod syntax;
 
