@@ -4,7 +4,9 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use crate::assignment_outputs::AssignmentOutputs;
-use crate::case::{self, AssignmentOptions, Case, LoadOptions, case_to_toml, load_assignment_scene};
+use crate::case::{
+    self, AssignmentOptions, Case, LoadOptions, case_to_toml, case_to_toml_anywhere, load_assignment_scene,
+};
 use crate::error::Error;
 use crate::film::{Film, OutputOptions, write_outputs};
 use crate::options::{RenderOptions, Spawn};
@@ -151,8 +153,12 @@ fn measured_run(
 }
 
 /// `goldray import`: the TOML case equivalent to a course scene file, with asset paths
-/// relative to where the TOML will live.
-pub fn import_assignment(scene: &Path, options: &AssignmentOptions, toml_path: &Path) -> Result<String, Error> {
+/// relative to where the TOML will live, or absolute when that is unknown (`None`: standard
+/// output).
+pub fn import_assignment(scene: &Path, options: &AssignmentOptions, toml_path: Option<&Path>) -> Result<String, Error> {
     let case = load_assignment_scene(scene, options)?;
-    Ok(case_to_toml(&case, toml_path))
+    Ok(match toml_path {
+        Some(path) => case_to_toml(&case, path),
+        None => case_to_toml_anywhere(&case),
+    })
 }

@@ -357,3 +357,22 @@ fn help_speaks_each_command_s_own_syntax() {
         "--jobs is a hidden alias: {text}"
     );
 }
+
+/// `goldray import scene.txt > anywhere/case.toml` must give a case that loads where it is saved,
+/// so asset paths written to standard output are absolute, and the header says so.
+#[test]
+fn import_to_standard_output_works_wherever_the_output_is_saved() {
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/mit6837/scene05_bunny_200.txt");
+    let result = goldray(&["import", scene.to_str().unwrap(), "-size", "40", "40"]);
+    assert!(result.status.success(), "{}", stderr(&result));
+    let text = String::from_utf8(result.stdout).unwrap();
+    assert!(text.contains("# Paths are absolute"), "{text}");
+    let dir = tempfile::tempdir().unwrap();
+    let saved = dir.path().join("sub/deeper/case.toml");
+    fs::create_dir_all(saved.parent().unwrap()).unwrap();
+    fs::write(&saved, &text).unwrap();
+    let out = dir.path().join("out");
+    let render = goldray(&["render", saved.to_str().unwrap(), "--out", out.to_str().unwrap(), "--quiet"]);
+    assert!(render.status.success(), "{}", stderr(&render));
+    assert!(out.join("case.png").is_file());
+}
