@@ -29,14 +29,14 @@ use goldray::geometry::aabb::Aabb;
 use goldray::geometry::bvh::Bvh;
 use goldray::geometry::generate::{blob, write_obj};
 use goldray::geometry::mesh::{Mesh, VertexNormals};
-use goldray::options::{Filter, Profile, RenderOptions, Spawn};
+use goldray::options::{Filter, Profile, RenderOptions, Spawn, Trace};
 use goldray::pipeline::{render_case, render_options};
-use goldray::progress::Progress;
+use goldray::progress::Silent;
 use goldray::real::{Color, Real, Vec3};
-use goldray::render::camera::Camera;
-use goldray::render::light::Light;
-use goldray::render::material::Material;
 use goldray::render::{render, render_counting_rays};
+use goldray::scene::camera::Camera;
+use goldray::scene::light::Light;
+use goldray::scene::material::Material;
 use goldray::scene::{Aggregate, Background, Object, Scene, Shape, build_scene};
 use rayon::prelude::*;
 
@@ -81,13 +81,15 @@ fn blob_scene_lit(lights: Vec<Light>) -> Scene {
 
 fn primary_rays(c: &mut Criterion) {
     let options = RenderOptions {
-        width: SIDE,
-        height: SIDE,
-        bounces: 0,
-        shadows: false,
-        samples: 1,
-        seed: 0,
-        filter: Filter::None,
+        trace: Trace {
+            width: SIDE,
+            height: SIDE,
+            bounces: 0,
+            shadows: false,
+            samples: 1,
+            seed: 0,
+            filter: Filter::None,
+        },
         spawn: Spawn::ErrorBounds,
         aovs: true,
     };
@@ -101,7 +103,7 @@ fn primary_rays(c: &mut Criterion) {
             .expect("a thread pool");
         group.bench_function(format!("blob_1.3M/{threads}_threads"), |b| {
             let scene = blob_scene();
-            b.iter(|| pool.install(|| render(&scene, &options, &Progress::hidden())))
+            b.iter(|| pool.install(|| render(&scene, &options, &Silent)))
         });
     }
     group.finish();
@@ -197,7 +199,7 @@ fn end_to_end(c: &mut Criterion) {
         group.bench_function(name, |b| {
             b.iter(|| {
                 let case = load(&path, &LoadOptions::default()).expect("a shipped case loads");
-                render_case(&case, false).expect("a shipped case renders")
+                render_case(&case).expect("a shipped case renders")
             })
         });
     }
@@ -216,11 +218,7 @@ const COURSE_COMMANDS: [(&str, (f64, f64), u32, bool); 7] = [
 ];
 
 fn course_scenes(c: &mut Criterion) {
-    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/mit6837/data");
-    assert!(
-        data.is_dir(),
-        "../shared/mit6837 is missing: the course benchmark needs its scenes"
-    );
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/mit6837");
     let mut group = c.benchmark_group("course_scenes");
     group.sample_size(10);
     group.bench_function("seven_at_800", |b| {
@@ -237,7 +235,7 @@ fn course_scenes(c: &mut Criterion) {
                 };
                 let case =
                     load_assignment_scene(&data.join(format!("{scene}.txt")), &options).expect("a course scene loads");
-                let film = render_case(&case, false).expect("a course scene renders");
+                let film = render_case(&case).expect("a course scene renders");
                 let (min, max) = (depth_range.0 as f32, depth_range.1 as f32);
                 for image in [
                     color_image(&film, Tonemap::Clamp),
@@ -276,13 +274,13 @@ fn stats_overhead(c: &mut Criterion) {
         let case = load(&path, &LoadOptions::default()).expect("a shipped case loads");
         let scene = build_scene(&case).expect("a shipped case builds");
         let options = render_options(&case);
-        let (_, rays) = pool.install(|| render_counting_rays(&scene, &options, &Progress::hidden()));
+        let (_, rays) = pool.install(|| render_counting_rays(&scene, &options, &Silent));
         group.throughput(Throughput::Elements(rays.total()));
         group.bench_function(format!("{}/off", case.name), |b| {
-            b.iter(|| pool.install(|| render(&scene, &options, &Progress::hidden())))
+            b.iter(|| pool.install(|| render(&scene, &options, &Silent)))
         });
         group.bench_function(format!("{}/on", case.name), |b| {
-            b.iter(|| pool.install(|| render_counting_rays(&scene, &options, &Progress::hidden())))
+            b.iter(|| pool.install(|| render_counting_rays(&scene, &options, &Silent)))
         });
     }
     group.finish();
@@ -299,13 +297,15 @@ fn only_what_is_required(c: &mut Criterion) {
         falloff: 0.05,
     };
     let options = |shadows, samples, aovs| RenderOptions {
-        width: SIDE,
-        height: SIDE,
-        bounces: 0,
-        shadows,
-        samples,
-        seed: 0,
-        filter: Filter::None,
+        trace: Trace {
+            width: SIDE,
+            height: SIDE,
+            bounces: 0,
+            shadows,
+            samples,
+            seed: 0,
+            filter: Filter::None,
+        },
         spawn: Spawn::ErrorBounds,
         aovs,
     };
@@ -325,7 +325,7 @@ fn only_what_is_required(c: &mut Criterion) {
     for (name, lights, options) in &renders {
         group.bench_function(format!("blob_1.3M/{name}"), |b| {
             let scene = blob_scene_lit(lights.clone());
-            b.iter(|| pool.install(|| render(&scene, options, &Progress::hidden())))
+            b.iter(|| pool.install(|| render(&scene, options, &Silent)))
         });
     }
     group.finish();

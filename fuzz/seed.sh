@@ -1,19 +1,15 @@
 #!/usr/bin/env bash
-# Fills fuzz/corpus/<target>/ with seed inputs: the project's own cases, OBJ and PNG files, the
-# course scenes in ../shared (read at run time, never copied into the repository) and random
-# valid course scenes from the differential test's generator (examples/course_diff).
+# Fills fuzz/corpus/<target>/ with seed inputs: the project's own cases, the course's scenes and
+# meshes (cases/mit6837/), one of its reference images, a fresh render, and random valid course
+# scenes from the differential test's generator (examples/course_diff).
 set -euo pipefail
 cd "$(dirname "$0")"
-shared=../../shared/mit6837
+course=../cases/mit6837
 mkdir -p corpus/case_toml corpus/assignment_scene corpus/obj corpus/png_decode
 cp ../cases/*.toml corpus/case_toml/
-if [ -d "$shared" ]; then
-    cp "$shared"/data/scene0*.txt corpus/assignment_scene/
-    cp "$shared"/data/models/cube*.obj "$shared"/data/models/c1.obj "$shared"/data/models/bunny_200.obj corpus/obj/
-    cp "$shared"/reference/a02.png corpus/png_decode/
-else
-    echo "warning: $shared is missing; seeding from the project's own files only" >&2
-fi
+cp "$course"/scene0*.txt corpus/assignment_scene/
+cp "$course"/models/cube*.obj "$course"/models/c1.obj "$course"/models/bunny_200.obj corpus/obj/
+cp ../tests/data/mit6837/a02.png corpus/png_decode/
 printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1\n' > corpus/obj/triangle.obj
 printf 'PerspectiveCamera { center 0 0 10 direction 0 0 -1 up 0 1 0 angle 30 }\nMaterials { numMaterials 1 Material { } }\nGroup { numObjects 1 MaterialIndex 0 Sphere { center 0 0 0 radius 1 } }\n' > corpus/assignment_scene/minimal.txt
 # Random valid scenes of the differential test: every block, field orders, number forms, nesting.

@@ -3,9 +3,8 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::film::{
-    Film, OutputError, Tonemap, color_image, depth_image, encode_exr, encode_png, normals_image, write_file_atomic,
-};
+use crate::atomic_write::write_file_atomic;
+use crate::film::{Film, OutputError, Tonemap, color_image, depth_image, encode_exr, encode_png, normals_image};
 
 /// Where `goldray mit6837` writes, mirroring the course binary's `-output`, `-normals` and
 /// `-depth min max file` flags.

@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use crate::case::SourceLocation;
+use crate::located_toml::SourceLocation;
 
 #[derive(Debug, thiserror::Error)]
 pub enum BuildError {

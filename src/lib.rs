@@ -6,12 +6,16 @@
 //! single-precision ones, the default, are also reachable at the crate root.
 
 pub mod assignment_outputs;
+pub mod atomic_write;
 pub mod build_error;
 pub mod case;
 pub mod compare;
 pub mod error;
 pub mod film;
 pub mod grade;
+pub mod image_size;
+pub mod located_toml;
+pub mod named_enum;
 pub mod options;
 pub mod pipeline;
 pub mod precision;

@@ -1,59 +1,41 @@
 //! How to render, independent of the precision the renderer is compiled in.
 
-use serde::Deserialize;
+use crate::named_enum::named_enum;
 
-/// Which camera and image conventions to follow.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum Profile {
-    /// Pixel centres, vertical fov with aspect correction, orthonormal camera basis.
-    #[default]
-    Native,
-    /// The course's reference renderer, quirks included (DESIGN.md, "The assignment profile").
-    Mit6837,
-}
-
-/// How each output pixel is reconstructed from samples.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum Filter {
-    /// Each pixel is the mean of its own samples.
-    #[default]
-    None,
-    /// Render at 3× width and height, then weight each 3×3 block by [1 2 1]⊗[1 2 1]/16.
-    Gaussian,
-}
-
-impl Filter {
-    /// The name a case file uses.
-    pub fn name(self) -> &'static str {
-        match self {
-            Filter::None => "none",
-            Filter::Gaussian => "gaussian",
-        }
+named_enum! {
+    /// Which camera and image conventions to follow.
+    #[derive(Default)]
+    pub enum Profile: "profile" {
+        /// Pixel centres, vertical fov with aspect correction, orthonormal camera basis.
+        #[default]
+        Native = "native",
+        /// The course's reference renderer, quirks included (docs/ARCHITECTURE.md,
+        /// "The assignment profile").
+        Mit6837 = "mit6837",
     }
 }
 
-/// The floating-point type of all geometry and shading. The film is `f32` either way, because
-/// that is what the EXR holds; `F64` buys accuracy far from the origin or across extreme scales
-/// with speed (see README, "Numerical stability").
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Default)]
-#[serde(rename_all = "lowercase")]
-pub enum Precision {
-    #[default]
-    F32,
-    F64,
+named_enum! {
+    /// How each output pixel is reconstructed from samples.
+    #[derive(Default)]
+    pub enum Filter: "filter" {
+        /// Each pixel is the mean of its own samples.
+        #[default]
+        None = "none",
+        /// Render at 3× width and height, then weight each 3×3 block by [1 2 1]⊗[1 2 1]/16.
+        Gaussian = "gaussian",
+    }
 }
 
-impl Precision {
-    pub const ALL: [Precision; 2] = [Precision::F32, Precision::F64];
-
-    /// The name a case file uses.
-    pub fn name(self) -> &'static str {
-        match self {
-            Precision::F32 => "f32",
-            Precision::F64 => "f64",
-        }
+named_enum! {
+    /// The floating-point type of all geometry and shading. The film is `f32` either way, because
+    /// that is what the EXR holds; `F64` buys accuracy far from the origin or across extreme scales
+    /// with speed (see README, "Numerical stability").
+    #[derive(Default)]
+    pub enum Precision: "precision" {
+        #[default]
+        F32 = "f32",
+        F64 = "f64",
     }
 }
 
@@ -83,15 +65,25 @@ impl Spawn {
     pub const COURSE_MIRROR_THRESHOLD: f64 = 0.1;
 }
 
+/// What a render traces: the part a case's `[render]` table and the renderer's options share,
+/// defined once so that the two cannot drift apart.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RenderOptions {
+pub struct Trace {
     pub width: u32,
     pub height: u32,
     pub bounces: u32,
     pub shadows: bool,
+    /// Per pixel (per sub-pixel with the Gaussian filter); a perfect square, so that stratified
+    /// jitter can use an n×n grid.
     pub samples: u32,
     pub seed: u64,
     pub filter: Filter,
+}
+
+/// What the renderer is asked to do: the trace, plus what a case file cannot choose.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RenderOptions {
+    pub trace: Trace,
     pub spawn: Spawn,
     /// Whether anything reads the depth and normal AOVs. Without them no ray is traced for
     /// them and the film's `depth` and `normal` stay as [`crate::film::Film::new`] made them:

@@ -4,11 +4,13 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use crate::assignment_outputs::AssignmentOutputs;
-use crate::case::{self, AssignmentOptions, Case, LoadOptions, case_to_toml, load_assignment_scene};
+use crate::case::{
+    self, AssignmentOptions, Case, LoadOptions, case_to_toml, case_to_toml_anywhere, load_assignment_scene,
+};
 use crate::error::Error;
 use crate::film::{Film, OutputOptions, write_outputs};
 use crate::options::{Profile, RenderOptions, Spawn};
-use crate::progress::Progress;
+use crate::progress::{Progress, Silent};
 use crate::stats::{BuildStats, Phases, RayCounts, RenderStats};
 use crate::with_precision;
 
@@ -19,25 +21,38 @@ pub struct Rendered {
     pub stats: RenderStats,
 }
 
-/// Renders a loaded case to a film, in the precision it asks for, showing progress when asked.
-pub fn render_case(case: &Case, show_progress: bool) -> Result<Film, Error> {
+/// Renders a loaded case to a film, in the precision it asks for.
+pub fn render_case(case: &Case) -> Result<Film, Error> {
+    render_case_reporting(case, &Silent)
+}
+
+/// [`render_case`], reporting the rows done to `progress`.
+pub fn render_case_reporting(case: &Case, progress: &dyn Progress) -> Result<Film, Error> {
     with_precision!(case.render.precision, p => {
         let scene = p::scene::build_scene(case)?;
-        Ok(p::render::render(&scene, &render_options(case), &progress(case, show_progress)))
+        Ok(rendering(case, progress, |progress| p::render::render(&scene, &render_options(case), progress)))
     })
+}
+
+/// Brackets one render in `begin`/`finish`, counting its rows.
+fn rendering<T>(case: &Case, progress: &dyn Progress, render: impl FnOnce(&dyn Progress) -> T) -> T {
+    progress.begin(&case.name, u64::from(case.render.trace.height));
+    let result = render(progress);
+    progress.finish();
+    result
 }
 
 /// [`render_case`], also counting rays and measuring the scene build (for `--stats`), with the
 /// depth and normal AOVs only when `aovs`. The scene is freed before this returns, so measuring
 /// adds no memory to what follows.
-pub fn render_case_measured(case: &Case, show_progress: bool, aovs: bool) -> Result<MeasuredRender, Error> {
+pub fn render_case_measured(case: &Case, progress: &dyn Progress, aovs: bool) -> Result<MeasuredRender, Error> {
     with_precision!(case.render.precision, p => {
         let start = Instant::now();
         let (scene, build_stats) = p::scene::build_scene_measured(case)?;
         let build_time = start.elapsed();
         let render_start = Instant::now();
         let options = RenderOptions { aovs, ..render_options(case) };
-        let (film, rays) = p::render::render_counting_rays(&scene, &options, &progress(case, show_progress));
+        let (film, rays) = rendering(case, progress, |progress| p::render::render_counting_rays(&scene, &options, progress));
         Ok(MeasuredRender { film, rays, build_stats, build_time, render_time: render_start.elapsed() })
     })
 }
@@ -55,25 +70,14 @@ pub struct MeasuredRender {
 /// The renderer's options from a case's `[render]` table. A case's render always writes the
 /// EXR, whose `Z` and `N` channels are the AOVs, so they are always traced.
 pub fn render_options(case: &Case) -> RenderOptions {
-    let settings = &case.render;
     RenderOptions {
-        width: settings.width,
-        height: settings.height,
-        bounces: settings.bounces,
-        shadows: settings.shadows,
-        samples: settings.samples,
-        seed: settings.seed,
-        filter: settings.filter,
-        spawn: match settings.profile {
+        trace: case.render.trace,
+        spawn: match case.render.profile {
             Profile::Native => Spawn::ErrorBounds,
             Profile::Mit6837 => Spawn::Course,
         },
         aovs: true,
     }
-}
-
-fn progress(case: &Case, show_progress: bool) -> Progress {
-    Progress::new(u64::from(case.render.height), &case.name, show_progress)
 }
 
 /// The files a case's render writes, as its options ask.
@@ -91,11 +95,11 @@ pub fn render_case_file(
     path: &Path,
     out_dir: &Path,
     load: &LoadOptions,
-    show_progress: bool,
+    progress: &dyn Progress,
 ) -> Result<Rendered, Error> {
     measured_run(
         || Ok(case::load(path, load)?),
-        show_progress,
+        progress,
         true,
         |case, film| Ok(write_outputs(out_dir, &case.name, film, &output_options(case))?),
     )
@@ -107,11 +111,11 @@ pub fn render_assignment(
     scene: &Path,
     options: &AssignmentOptions,
     outputs: &AssignmentOutputs,
-    show_progress: bool,
+    progress: &dyn Progress,
 ) -> Result<Rendered, Error> {
     measured_run(
         || Ok(load_assignment_scene(scene, options)?),
-        show_progress,
+        progress,
         outputs.writes_aovs(),
         |_, film| Ok(outputs.write(film)?),
     )
@@ -123,14 +127,14 @@ pub fn render_assignment(
 /// change what is rendered.
 fn measured_run(
     load: impl FnOnce() -> Result<Case, Error>,
-    show_progress: bool,
+    progress: &dyn Progress,
     aovs: bool,
     write: impl FnOnce(&Case, &Film) -> Result<Vec<PathBuf>, Error>,
 ) -> Result<Rendered, Error> {
     let start = Instant::now();
     let case = load()?;
     let parse = start.elapsed();
-    let measured = render_case_measured(&case, show_progress, aovs)?;
+    let measured = render_case_measured(&case, progress, aovs)?;
     let write_start = Instant::now();
     let written = write(&case, &measured.film)?;
     let phases = Phases {
@@ -141,7 +145,8 @@ fn measured_run(
         total: start.elapsed(),
     };
     let stats = RenderStats::new(
-        &case,
+        &case.name,
+        (case.render.trace.width, case.render.trace.height),
         phases,
         measured.build_stats,
         &measured.rays,
@@ -151,8 +156,12 @@ fn measured_run(
 }
 
 /// `goldray import`: the TOML case equivalent to a course scene file, with asset paths
-/// relative to where the TOML will live.
-pub fn import_assignment(scene: &Path, options: &AssignmentOptions, toml_path: &Path) -> Result<String, Error> {
+/// relative to where the TOML will live, or absolute when that is unknown (`None`: standard
+/// output).
+pub fn import_assignment(scene: &Path, options: &AssignmentOptions, toml_path: Option<&Path>) -> Result<String, Error> {
     let case = load_assignment_scene(scene, options)?;
-    Ok(case_to_toml(&case, toml_path))
+    Ok(match toml_path {
+        Some(path) => case_to_toml(&case, path),
+        None => case_to_toml_anywhere(&case),
+    })
 }

@@ -1,52 +1,34 @@
-//! A progress bar that only appears for work that takes long enough to need one.
+//! How long-running work says how far it has got, without the library drawing anything.
+//!
+//! The library reports; the command line decides what a report becomes (a bar on a terminal, one
+//! line per step in a log, or nothing with `--quiet`). Keeping the drawing out means a library
+//! caller never finds goldray writing to its terminal.
 
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::{Duration, Instant};
+/// Receives progress from a render, a golden preparation, a grading run or a tradeoff sweep.
+/// Every method has a do-nothing default, so an observer implements only what it shows. Calls may
+/// come from any worker thread.
+pub trait Progress: Sync {
+    /// A piece of work of `total` units begins; `label` names it ("rendering jitter", "grading").
+    fn begin(&self, _label: &str, _total: u64) {}
 
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+    /// The work turned out larger: `amount` more units are expected.
+    fn grow(&self, _amount: u64) {}
 
-/// Renders shorter than this finish before a bar would be readable; showing one would only
-/// flicker.
-const SHOW_AFTER: Duration = Duration::from_secs(1);
+    /// A named step begins (a sweep's setting, a golden render): worth a line in a log.
+    fn step(&self, _name: &str) {}
 
-pub struct Progress {
-    bar: ProgressBar,
-    enabled: bool,
-    visible: AtomicBool,
-    started: Instant,
+    /// `amount` more units are done.
+    fn advance(&self, _amount: u64) {}
+
+    /// One named item is done (a student graded): worth a line in a log.
+    fn done(&self, _name: &str) {}
+
+    /// The work is over, whether it succeeded or not.
+    fn finish(&self) {}
 }
 
-impl Progress {
-    /// `enabled = false` (the CLI's `--quiet`, and every library caller that doesn't ask) never
-    /// draws anything.
-    pub fn new(total: u64, message: &str, enabled: bool) -> Progress {
-        let bar = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::hidden());
-        if let Ok(style) = ProgressStyle::with_template("{msg} [{bar:40}] {percent:>3}% {elapsed} (eta {eta})") {
-            bar.set_style(style.progress_chars("=> "));
-        }
-        bar.set_message(message.to_string());
-        Progress {
-            bar,
-            enabled,
-            visible: AtomicBool::new(false),
-            started: Instant::now(),
-        }
-    }
+/// Reports to nobody: what library calls that do not ask for progress get.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Silent;
 
-    pub fn hidden() -> Progress {
-        Progress::new(0, "", false)
-    }
-
-    pub fn advance(&self, amount: u64) {
-        self.bar.inc(amount);
-        if self.enabled && self.started.elapsed() >= SHOW_AFTER && !self.visible.swap(true, Ordering::Relaxed) {
-            self.bar.set_draw_target(ProgressDrawTarget::stderr());
-        }
-    }
-
-    pub fn finish(&self) {
-        if self.visible.load(Ordering::Relaxed) {
-            self.bar.finish_and_clear();
-        }
-    }
-}
+impl Progress for Silent {}

@@ -39,15 +39,9 @@ const SCENES: [&str; 7] = [
     "scene07_arch.txt",
 ];
 
-/// The course data is shared, not vendored; its absence must fail loudly, never skip.
+/// The course's scenes, with their `models/` and `tex/`.
 fn data_dir() -> PathBuf {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/mit6837/data");
-    assert!(
-        dir.join("models/cube2.obj").is_file(),
-        "../shared/mit6837 is missing: the course scenes must be at {}",
-        dir.display()
-    );
-    dir
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/mit6837")
 }
 
 fn course_scene(name: &str) -> Case {
@@ -110,12 +104,21 @@ fn all_seven_course_scenes_load_with_the_course_defaults() {
         let case = course_scene(name);
         assert_eq!(case.name, name.trim_end_matches(".txt"));
         let r = &case.render;
-        assert_eq!((r.width, r.height, r.bounces, r.samples, r.seed), (100, 100, 0, 1, 0));
         assert_eq!(
-            (r.profile, r.tonemap, r.filter),
+            (
+                r.trace.width,
+                r.trace.height,
+                r.trace.bounces,
+                r.trace.samples,
+                r.trace.seed
+            ),
+            (100, 100, 0, 1, 0)
+        );
+        assert_eq!(
+            (r.profile, r.tonemap, r.trace.filter),
             (Profile::Mit6837, Tonemap::Clamp, Filter::None)
         );
-        assert!(!r.shadows && !r.normals && r.depth_range.is_none());
+        assert!(!r.trace.shadows && !r.normals && r.depth_range.is_none());
         assert!(!case.objects.is_empty(), "{name}");
     }
 }
@@ -330,9 +333,12 @@ fn the_flags_become_render_settings() {
     let path = data_dir().join("scene07_arch.txt");
     let case = load_assignment_scene(&path, &options).unwrap();
     let r = &case.render;
-    assert_eq!((r.width, r.height, r.bounces, r.samples), (800, 600, 4, 16));
-    assert!(r.shadows && r.normals);
-    assert_eq!(r.filter, Filter::Gaussian);
+    assert_eq!(
+        (r.trace.width, r.trace.height, r.trace.bounces, r.trace.samples),
+        (800, 600, 4, 16)
+    );
+    assert!(r.trace.shadows && r.normals);
+    assert_eq!(r.trace.filter, Filter::Gaussian);
     assert_eq!(r.depth_range, Some((8.0, 18.0)));
     assert_eq!(case.tolerance, course_scene("scene01_plane.txt").tolerance);
     let bad = AssignmentOptions {

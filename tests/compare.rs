@@ -8,8 +8,10 @@ mod diff_cli;
 
 use std::path::Path;
 
-use goldray::case::{Case, LoadOptions, Tolerance, load, parse};
-use goldray::compare::{Comparison, EXR_DEFAULTS, FAILING, Image, Limit, NON_FINITE, Verdict, compare, diff_heatmap};
+use goldray::case::{Case, LoadOptions, load, parse};
+use goldray::compare::{
+    Comparison, EXR_DEFAULTS, FAILING, Image, Limit, NON_FINITE, Tolerance, Verdict, compare, diff_heatmap,
+};
 use goldray::film::Film;
 use goldray::pipeline::render_case;
 
@@ -21,7 +23,7 @@ fn case(name: &str) -> Case {
 }
 
 fn render(case: &Case) -> Film {
-    render_case(case, false).unwrap_or_else(|e| panic!("{e}"))
+    render_case(case).unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn render_with_threads(case: &Case, threads: usize) -> Film {
@@ -132,7 +134,7 @@ fn fails_a_one_pixel_shift_of_the_edges() {
 fn fails_a_missing_shadow() {
     let with = case("spheres_shadows");
     let mut without = with.clone();
-    without.render.shadows = false;
+    without.render.trace.shadows = false;
     let comparison = judge(&render(&with), &render(&without), &with.tolerance);
     assert_fails_on(&comparison, Limit::FailFraction);
     assert_fails_on(&comparison, Limit::Rmse);
@@ -208,7 +210,7 @@ fn an_infinite_colour_fails_but_a_depth_that_turns_into_a_miss_is_only_a_failing
 fn reports_a_size_change_as_a_mismatch() {
     let golden = case("directional_light");
     let mut wider = golden.clone();
-    wider.render.width += 1;
+    wider.render.trace.width += 1;
     let comparison = judge(&render(&golden), &render(&wider), &EXR_DEFAULTS);
     assert!(matches!(comparison.verdict, Verdict::Mismatch { .. }), "{comparison}");
     assert_eq!(comparison.verdict.exit_code(), 3);

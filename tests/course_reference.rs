@@ -1,5 +1,6 @@
 //! The `mit6837` profile against the course's own reference renderer, and the drop-in command
-//! against the imported TOML case. Reads `../shared/mit6837/` beside the project root.
+//! against the imported TOML case. Reads the course's scenes from `cases/mit6837/` and its
+//! reference images from `tests/data/mit6837/`.
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -10,14 +11,16 @@ use goldray::film::{Tonemap, color_image, depth_image, normals_image};
 use goldray::pipeline::render_case;
 use image::RgbImage;
 
-fn shared() -> PathBuf {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/mit6837");
-    assert!(
-        dir.is_dir(),
-        "../shared/mit6837 is missing (looked for {}): these tests need the course's scenes and reference images beside the project root",
-        dir.display()
-    );
-    dir
+/// The course's scene `file` (e.g. `scene01_plane.txt`).
+fn scene_path(file: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/mit6837").join(file)
+}
+
+/// The course's reference image `file` (e.g. `a01.png`).
+fn reference_path(file: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/mit6837")
+        .join(file)
 }
 
 fn goldray(args: &[&str]) -> Output {
@@ -50,7 +53,6 @@ fn agreement(ours: &RgbImage, reference: &RgbImage, tolerance: u8) -> (f64, Vec<
 }
 
 fn check_against_reference(scene: &str, reference: &str, depth_range: (f64, f64)) {
-    let shared = shared();
     let options = AssignmentOptions {
         width: 800,
         height: 800,
@@ -58,8 +60,8 @@ fn check_against_reference(scene: &str, reference: &str, depth_range: (f64, f64)
         normals: true,
         ..AssignmentOptions::default()
     };
-    let case = load_assignment_scene(&shared.join("data").join(scene), &options).unwrap_or_else(|e| panic!("{e}"));
-    let film = render_case(&case, false).unwrap_or_else(|e| panic!("{e}"));
+    let case = load_assignment_scene(&scene_path(scene), &options).unwrap_or_else(|e| panic!("{e}"));
+    let film = render_case(&case).unwrap_or_else(|e| panic!("{e}"));
     let (min, max) = (depth_range.0 as f32, depth_range.1 as f32);
     let images = [
         ("colour", color_image(&film, Tonemap::Clamp), format!("{reference}.png")),
@@ -75,7 +77,7 @@ fn check_against_reference(scene: &str, reference: &str, depth_range: (f64, f64)
         ),
     ];
     for (what, ours, file) in images {
-        let expected = image::open(shared.join("reference").join(&file))
+        let expected = image::open(reference_path(&file))
             .unwrap_or_else(|e| panic!("{file}: {e}"))
             .into_rgb8();
         let (fraction, off) = agreement(&ours, &expected, 2);
@@ -122,10 +124,9 @@ const GRADING: [(&str, &[&str]); 7] = [
 
 #[test]
 fn drop_in_command_and_imported_case_give_identical_files() {
-    let shared = shared();
     for (scene, flags) in GRADING {
         let dir = tempfile::tempdir().unwrap();
-        let input = shared.join("data").join(format!("{scene}.txt"));
+        let input = scene_path(&format!("{scene}.txt"));
         let at = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
 
         let mut course = vec![
@@ -189,8 +190,7 @@ fn drop_in_command_and_imported_case_give_identical_files() {
 
 #[test]
 fn the_course_command_line_rejects_what_the_course_binary_would() {
-    let shared = shared();
-    let input = shared.join("data/scene01_plane.txt");
+    let input = scene_path("scene01_plane.txt");
     let run = |args: &[&str]| Command::new(env!("CARGO_BIN_EXE_goldray")).args(args).output().unwrap();
     let unknown = run(&[
         "mit6837",
@@ -212,7 +212,8 @@ fn the_course_command_line_rejects_what_the_course_binary_would() {
         "0",
         "10",
     ]);
-    assert_eq!(zero.status.code(), Some(1));
+    // A bad command line exits 2, like clap's own errors.
+    assert_eq!(zero.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&zero.stderr).contains("size 0 10"));
     let no_input = run(&["mit6837", "-output", "x.png"]);
     assert!(!no_input.status.success());
@@ -225,7 +226,7 @@ fn the_course_command_line_rejects_what_the_course_binary_would() {
         "8",
         "d.png",
     ]);
-    assert_eq!(bad_depth.status.code(), Some(1));
+    assert_eq!(bad_depth.status.code(), Some(2));
     assert!(
         !Path::new("x.png").exists() && !Path::new("d.png").exists(),
         "failed commands write nothing"
@@ -234,11 +235,10 @@ fn the_course_command_line_rejects_what_the_course_binary_would() {
 
 #[test]
 fn import_refuses_to_overwrite_without_force() {
-    let shared = shared();
     let dir = tempfile::tempdir().unwrap();
     let target = dir.path().join("mine.toml");
     fs::write(&target, "# my own notes\n").unwrap();
-    let input = shared.join("data/scene02_cube.txt");
+    let input = scene_path("scene02_cube.txt");
     let refused = Command::new(env!("CARGO_BIN_EXE_goldray"))
         .args(["import", input.to_str().unwrap(), "-o", target.to_str().unwrap()])
         .output()

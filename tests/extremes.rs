@@ -11,10 +11,10 @@ use goldray::geometry::sphere::Sphere;
 use goldray::options::{Profile, Spawn};
 use goldray::pipeline::render_case;
 use goldray::real::{Color, Real, Vec3};
-use goldray::render::camera::Camera;
 use goldray::render::integrator::Whitted;
-use goldray::render::light::Light;
-use goldray::render::material::Material;
+use goldray::scene::camera::Camera;
+use goldray::scene::light::Light;
+use goldray::scene::material::Material;
 use goldray::scene::{Aggregate, Background, Object, Scene, Shape, Triangle};
 use goldray::stats::RayCounts;
 use proptest::prelude::*;
@@ -24,7 +24,7 @@ const CAMERA: &str = "[camera]\ncenter = [0, 0, 10]\ndirection = [0, 0, -1]\nup 
 
 fn render_in(dir: &Path, toml: &str) -> Result<Film, String> {
     let case = parse(toml, &dir.join("extreme.toml"), &LoadOptions::default()).map_err(|e| e.to_string())?;
-    render_case(&case, false).map_err(|e| e.to_string())
+    render_case(&case).map_err(|e| e.to_string())
 }
 
 fn render(toml: &str) -> Result<Film, String> {

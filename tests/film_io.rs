@@ -7,9 +7,9 @@ use std::io::Cursor;
 use std::path::{Path, PathBuf};
 
 use exr::prelude::{ReadChannels, ReadLayers};
+use goldray::atomic_write::{AtomicWriteError, write_file_atomic};
 use goldray::film::{
-    Film, OutputError, OutputOptions, Tonemap, decode_exr, encode_exr, read_exr, write_exr, write_file_atomic,
-    write_outputs,
+    Film, OutputError, OutputOptions, Tonemap, decode_exr, encode_exr, read_exr, write_exr, write_outputs,
 };
 
 /// A non-square film (height not a multiple of the 16-line ZIP block) with values that a lossy or
@@ -269,7 +269,10 @@ fn a_failed_write_leaves_existing_outputs_untouched_and_no_temp_files() {
         let before: Vec<Option<Vec<u8>>> = all.iter().map(|f| fs::read(dir.path().join(f)).ok()).collect();
 
         let error = write_outputs(dir.path(), "a", &varied_film(11), &all_options()).expect_err("blocked output");
-        assert!(matches!(error, OutputError::Write { .. }), "{error}");
+        assert!(
+            matches!(error, OutputError::Write(AtomicWriteError::Write { .. })),
+            "{error}"
+        );
         assert!(
             error
                 .to_string()

@@ -74,30 +74,10 @@ fn render(path: &Path) -> Result<Rendered, String> {
             shown(path)
         ));
     }
-    let case =
-        load(path, &LoadOptions::default()).map_err(|e| explain_missing_shared(path, e.to_string(), &shared_dir()))?;
-    let film = render_case(&case, false).map_err(|e| explain_missing_shared(path, e.to_string(), &shared_dir()))?;
+    let case = load(path, &LoadOptions::default()).map_err(|e| e.to_string())?;
+    let film = render_case(&case).map_err(|e| e.to_string())?;
     let exr = encode_exr(&film).map_err(|e| format!("{}: {e}", shown(path)))?;
     Ok(Rendered { case, film, exr })
-}
-
-/// The course's scenes and assets live in `shared/` beside the project; when a case that reads
-/// them fails and that directory is absent, say so instead of leaving a bare "file not found".
-fn explain_missing_shared(case: &Path, message: String, shared: &Path) -> String {
-    let uses_shared = fs::read_to_string(case).is_ok_and(|text| text.contains("shared/"));
-    if uses_shared && !shared.is_dir() {
-        format!(
-            "{message}\n  this case reads the course's files from {}, which is missing: put the shared/ directory \
-             beside the project root to run it",
-            shared.display()
-        )
-    } else {
-        message
-    }
-}
-
-fn shared_dir() -> PathBuf {
-    Path::new(ROOT).join("../shared")
 }
 
 #[test]
@@ -226,22 +206,4 @@ fn orphan_goldens(case_files: &[PathBuf]) -> Vec<String> {
 /// insta's own reading of `CI`, so the message matches what insta did.
 fn is_ci() -> bool {
     !matches!(std::env::var("CI").as_deref(), Err(_) | Ok("" | "0" | "false"))
-}
-
-#[test]
-fn a_case_that_needs_the_missing_shared_directory_says_so() {
-    let dir = tempfile::tempdir().expect("a temporary directory");
-    let case = dir.path().join("course.toml");
-    fs::write(
-        &case,
-        "[[object]]\nkind = \"mesh\"\nobj = \"../../shared/mit6837/bunny.obj\"\n",
-    )
-    .expect("written");
-    let message = explain_missing_shared(&case, "no such file".to_owned(), &dir.path().join("shared"));
-    assert!(
-        message.starts_with("no such file\n") && message.contains("is missing"),
-        "{message}"
-    );
-    let present = explain_missing_shared(&case, "no such file".to_owned(), dir.path());
-    assert_eq!(present, "no such file");
 }

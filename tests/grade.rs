@@ -20,6 +20,7 @@ use std::sync::OnceLock;
 use std::time::Instant;
 
 use goldray::grade::{ClassReport, GradeOptions, Outcome, StudentResult, grade_class};
+use goldray::progress::Silent;
 
 use class::{Class, FILES, HOSTILE, POINTS, make_class_at};
 
@@ -41,10 +42,10 @@ fn graded() -> &'static Graded {
         let options = GradeOptions {
             out: out.clone(),
             cache: None,
-            show_progress: false,
         };
         let started = Instant::now();
-        let report = grade_class(&class.rubric, &class.submissions, &options).unwrap_or_else(|e| panic!("{e}"));
+        let report =
+            grade_class(&class.rubric, &class.submissions, &options, &Silent).unwrap_or_else(|e| panic!("{e}"));
         let seconds = started.elapsed().as_secs_f64();
         Graded {
             class,
@@ -308,5 +309,66 @@ fn the_report_opens_in_headless_chromium_with_its_table_and_pictures() {
         colours.len() > 500,
         "the screenshot looks blank: {} colours",
         colours.len()
+    );
+}
+
+/// A rubric as wide as the course's (21 images): in a 1400-pixel window the per-image cells run
+/// off screen, but each student's name and the list of images that lost points stay in view.
+#[test]
+fn a_wide_class_table_keeps_names_and_lost_points_on_screen() {
+    use goldray::film::{Tonemap, color_image, encode_png};
+
+    let dir = tempfile::tempdir().unwrap();
+    let scene = class::scene_path();
+    let mut rubric = format!(
+        "title = \"Wide\"\n\n[defaults]\nthreshold = 8\npass_fraction = 0.01\n\n[render.spheres]\ncase = {scene:?}\nsize = [64, 64]\n"
+    );
+    let files: Vec<String> = (1..=21).map(|i| format!("c{i:02}.png")).collect();
+    for file in &files {
+        rubric.push_str(&format!("\n[image.\"{file}\"]\nrender = \"spheres\"\n"));
+    }
+    let rubric_path = dir.path().join("wide.toml");
+    fs::write(&rubric_path, rubric).unwrap();
+    let mut case = goldray::case::load(&scene, &goldray::case::LoadOptions::default()).unwrap();
+    case.render.trace.width = 64;
+    case.render.trace.height = 64;
+    let png = encode_png(&color_image(
+        &goldray::pipeline::render_case(&case).unwrap(),
+        Tonemap::Clamp,
+    ))
+    .unwrap();
+    for student in ["alice", "bob"] {
+        let folder = dir.path().join("submissions").join(student);
+        fs::create_dir_all(&folder).unwrap();
+        for file in &files {
+            // Bob's last image is missing: the cell furthest to the right.
+            if !(student == "bob" && file == "c21.png") {
+                fs::write(folder.join(file), &png).unwrap();
+            }
+        }
+    }
+    let out = dir.path().join("report");
+    let options = GradeOptions {
+        out: out.clone(),
+        cache: Some(dir.path().join("cache")),
+    };
+    let report = grade_class(&rubric_path, &dir.path().join("submissions"), &options, &Silent).unwrap();
+    assert_eq!(student(&report, "bob").images[20].outcome, Outcome::Missing);
+
+    let index = out.join("index.html");
+    let html = fs::read_to_string(&index).unwrap();
+    assert!(html.contains("<th>Lost points on</th>"), "{html}");
+    assert!(
+        html.contains(">1: <a class=\"v-missing\""),
+        "bob's summary names the missing image"
+    );
+    let dom = chromium::dump_dom_at(&index, 1400, 900);
+    assert!(
+        dom.contains("data-table-scrolls=\"true\""),
+        "21 columns overflow 1400 px:\n{dom}"
+    );
+    assert!(
+        dom.contains("data-summary-in-view=\"true\""),
+        "names and summaries stay on screen:\n{dom}"
     );
 }

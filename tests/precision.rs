@@ -4,8 +4,8 @@
 
 use std::path::Path;
 
-use goldray::case::{Case, LoadOptions, Tolerance, case_to_toml, load, parse};
-use goldray::compare::{Image, Verdict, compare};
+use goldray::case::{Case, LoadOptions, case_to_toml, load, parse};
+use goldray::compare::{Image, Tolerance, Verdict, compare};
 use goldray::film::{Film, encode_exr};
 use goldray::options::Precision;
 use goldray::pipeline::render_case;
@@ -21,7 +21,7 @@ fn case(name: &str, precision: Precision) -> Case {
 
 fn render_with_threads(case: &Case, threads: usize) -> Film {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-    pool.install(|| render_case(case, false).unwrap_or_else(|e| panic!("{e}")))
+    pool.install(|| render_case(case).unwrap_or_else(|e| panic!("{e}")))
 }
 
 #[test]

@@ -11,7 +11,7 @@ const CAMERA: &str = "[camera]\ncenter = [0, 0, 10]\ndirection = [0, 0, -1]\nup 
 
 fn render_in(dir: &Path, toml: &str) -> Film {
     let case = parse(toml, &dir.join("test.toml"), &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
-    render_case(&case, false).unwrap_or_else(|e| panic!("{e}"))
+    render_case(&case).unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn render(body: &str) -> Film {

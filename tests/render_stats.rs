@@ -11,7 +11,7 @@ use std::path::Path;
 use goldray::case::{Case, LoadOptions, parse};
 use goldray::film::Film;
 use goldray::pipeline::render_options;
-use goldray::progress::Progress;
+use goldray::progress::Silent;
 use goldray::render::{render, render_counting_rays};
 use goldray::scene::build_scene;
 use goldray::stats::RayCounts;
@@ -36,7 +36,7 @@ fn sized_case(render: &str, body: &str) -> Case {
 
 fn counted(case: &Case) -> (Film, RayCounts) {
     let scene = build_scene(case).unwrap_or_else(|e| panic!("{e}"));
-    render_counting_rays(&scene, &render_options(case), &Progress::hidden())
+    render_counting_rays(&scene, &render_options(case), &Silent)
 }
 
 fn rays(camera: u64, aov: u64, shadow: u64, reflection: u64) -> RayCounts {
@@ -149,6 +149,6 @@ fn counts_and_film_are_the_same_on_one_and_two_threads() {
 fn counting_does_not_change_the_film() {
     let case = busy_case();
     let scene = build_scene(&case).unwrap();
-    let plain = render(&scene, &render_options(&case), &Progress::hidden());
+    let plain = render(&scene, &render_options(&case), &Silent);
     assert!(counted(&case).0 == plain);
 }

@@ -11,7 +11,7 @@ use goldray::film::{Tonemap, color_image};
 use goldray::geometry::generate::{blob, write_obj};
 use goldray::options::{Precision, Spawn};
 use goldray::pipeline::render_options;
-use goldray::progress::Progress;
+use goldray::progress::Silent;
 use goldray::real::Vec3;
 use goldray::with_precision;
 use image::RgbImage;
@@ -131,7 +131,7 @@ fn render(case: &Case, spawn: Spawn) -> RgbImage {
     };
     let film = with_precision!(case.render.precision, p => {
         let scene = p::scene::build_scene(case).unwrap();
-        p::render::render(&scene, &options, &Progress::new(1, "", false))
+        p::render::render(&scene, &options, &Silent)
     });
     color_image(&film, Tonemap::Srgb)
 }

@@ -11,6 +11,7 @@ use std::time::Duration;
 
 use goldray::case::{Case, LoadOptions, parse};
 use goldray::options::{Filter, Precision};
+use goldray::progress::Silent;
 use goldray::tradeoff::{
     CSV_COLUMNS, CSV_FILE, MARKDOWN_FILE, Metric, PLOT_FILE, PLOT_HEIGHT, PLOT_WIDTH, SweepPlan, Tradeoff,
     TradeoffOptions, measure_tradeoff, pareto_front, run_tradeoff,
@@ -36,7 +37,7 @@ fn measure(case: &Case, plan: SweepPlan) -> Tradeoff {
         plan,
         ..TradeoffOptions::new("unused")
     };
-    measure_tradeoff(case, &options).unwrap_or_else(|e| panic!("{e}"))
+    measure_tradeoff(case, &options, &Silent).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Thin dark shapes with sharp edges on a bright background, flat-lit: nearly all the error is
@@ -283,7 +284,8 @@ fn shipped(name: &str) -> PathBuf {
 fn the_report_reads_back_with_every_setting_and_the_plot_decodes() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("report");
-    let (t, written) = run_tradeoff(&shipped("mirrors.toml"), &tiny_options(&out)).unwrap_or_else(|e| panic!("{e}"));
+    let (t, written) =
+        run_tradeoff(&shipped("mirrors.toml"), &tiny_options(&out), &Silent).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(
         written,
         [out.join(CSV_FILE), out.join(MARKDOWN_FILE), out.join(PLOT_FILE)]
@@ -341,9 +343,9 @@ fn the_report_reads_back_with_every_setting_and_the_plot_decodes() {
     );
 
     // A second run replaces its own report; a file goldray did not write is refused untouched.
-    run_tradeoff(&shipped("mirrors.toml"), &tiny_options(&out)).unwrap_or_else(|e| panic!("{e}"));
+    run_tradeoff(&shipped("mirrors.toml"), &tiny_options(&out), &Silent).unwrap_or_else(|e| panic!("{e}"));
     fs::write(out.join(MARKDOWN_FILE), "# my notes\n").unwrap();
-    let refused = run_tradeoff(&shipped("mirrors.toml"), &tiny_options(&out)).unwrap_err();
+    let refused = run_tradeoff(&shipped("mirrors.toml"), &tiny_options(&out), &Silent).unwrap_err();
     assert!(refused.to_string().contains("--force"), "{refused}");
     assert_eq!(fs::read_to_string(out.join(MARKDOWN_FILE)).unwrap(), "# my notes\n");
     run_tradeoff(
@@ -352,6 +354,7 @@ fn the_report_reads_back_with_every_setting_and_the_plot_decodes() {
             force: true,
             ..tiny_options(&out)
         },
+        &Silent,
     )
     .unwrap();
     assert!(
@@ -371,11 +374,11 @@ fn the_target_is_the_fastest_setting_that_meets_it_or_a_clear_no() {
         target_flip: Some(target),
         ..TradeoffOptions::new("unused")
     };
-    let all = measure_tradeoff(&case(EDGES), &options(1.0)).unwrap();
+    let all = measure_tradeoff(&case(EDGES), &options(1.0), &Silent).unwrap();
     let chosen = all.target.unwrap().chosen.expect("every setting meets FLIP ≤ 1");
     let fastest = all.measurements.iter().map(|m| m.seconds).fold(f64::MAX, f64::min);
     assert_eq!(all.measurements[chosen].seconds, fastest);
-    let none = measure_tradeoff(&case(EDGES), &options(0.0)).unwrap();
+    let none = measure_tradeoff(&case(EDGES), &options(0.0), &Silent).unwrap();
     assert_eq!(none.target.unwrap().chosen, None);
     let sentence = none.target_sentence().unwrap();
     assert!(sentence.starts_with("no setting reached FLIP mean ≤ 0;"), "{sentence}");
@@ -538,4 +541,44 @@ fn bad_input_is_a_clear_error_and_writes_nothing() {
     );
     assert_eq!(fs::read_to_string(out.join(CSV_FILE)).unwrap(), "name,score\nada,10\n");
     assert_eq!(fs::read_dir(&out).unwrap().count(), 1, "nothing else written");
+}
+
+/// When stderr is a log rather than a terminal, a long sweep still says what it is doing: one
+/// line per setting and one for the reference; `--quiet` silences them.
+#[test]
+fn progress_is_a_line_per_setting_when_stderr_is_not_a_terminal() {
+    let dir = tempfile::tempdir().unwrap();
+    let case = shipped("mirrors.toml");
+    let args = |out: &str| -> Vec<String> {
+        let mut args: Vec<String> = ["tradeoff", case.to_str().unwrap(), "--out", out]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+        args.extend(QUICK.iter().filter(|a| **a != "--quiet").map(|s| s.to_string()));
+        args
+    };
+    let out = dir.path().join("talking");
+    let talking = goldray(
+        &args(out.to_str().unwrap())
+            .iter()
+            .map(String::as_str)
+            .collect::<Vec<_>>(),
+    );
+    assert!(talking.status.success(), "{}", stderr(&talking));
+    let log = stderr(&talking);
+    let rows = fs::read_to_string(out.join(CSV_FILE)).unwrap().lines().count() - 1;
+    assert!(log.lines().any(|l| l.starts_with("reference (16 spp)")), "{log}");
+    // Setting labels read like `4spp gaussian 1b f32`.
+    let setting_lines = log
+        .lines()
+        .filter(|l| l.contains("spp ") && (l.ends_with(" f32") || l.ends_with(" f64")))
+        .count();
+    assert!(setting_lines >= rows, "one line per setting ({rows}):\n{log}");
+
+    let quiet_out = dir.path().join("quiet");
+    let mut quiet_args = args(quiet_out.to_str().unwrap());
+    quiet_args.push("--quiet".to_owned());
+    let quiet = goldray(&quiet_args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(quiet.status.success());
+    assert!(stderr(&quiet).is_empty(), "{}", stderr(&quiet));
 }

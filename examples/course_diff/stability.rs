@@ -32,7 +32,7 @@ pub fn unstable_pixels(
         for sign in [-1.0, 1.0] {
             let mut nudged = case.clone();
             nudged.camera.center[axis] += sign * NUDGE * distance;
-            let film = render_case(&nudged, false).map_err(|e| e.to_string())?;
+            let film = render_case(&nudged).map_err(|e| e.to_string())?;
             let image = match kind {
                 0 => color_image(&film, Tonemap::Clamp),
                 1 => normals_image(&film, Tonemap::Clamp),

@@ -33,6 +33,6 @@ fuzz_target!(|data: &[u8]| {
         panic!("an accepted scene must export to a case that loads: {e}\n{exported}");
     }
     if case.background.cube_map.is_none() {
-        let _ = render_case(&case, false);
+        let _ = render_case(&case);
     }
 });

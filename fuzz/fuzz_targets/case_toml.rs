@@ -15,14 +15,14 @@ fuzz_target!(|data: &[u8]| {
     let Ok(mut case) = parse(text, Path::new("fuzz/case.toml"), &LoadOptions::default()) else {
         return;
     };
-    let settings = &mut case.render;
+    let settings = &mut case.render.trace;
     settings.width = settings.width.min(4);
     settings.height = settings.height.min(4);
     settings.samples = settings.samples.min(4);
     settings.bounces = settings.bounces.min(4);
     for precision in Precision::ALL {
         case.render.precision = precision;
-        if let Ok(film) = render_case(&case, false) {
+        if let Ok(film) = render_case(&case) {
             assert!(
                 film.color.iter().flatten().all(|c| c.is_finite()),
                 "a non-finite colour reached the film"

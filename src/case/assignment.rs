@@ -21,7 +21,7 @@ use super::sections::MAX_BOUNCES;
 use super::spec::{BackgroundSpec, Case, MaterialSpec};
 use super::value::has_usable_length;
 use crate::film::Tonemap;
-use crate::options::{Filter, Precision, Profile};
+use crate::options::{Filter, Precision, Profile, Trace};
 
 /// The course binary's command-line flags that shape a render (`-size`, `-bounces`, `-shadows`,
 /// `-jitter`, `-filter`, `-depth`, `-normals`).
@@ -152,7 +152,7 @@ pub fn parse_assignment_scene(source: &str, path: &Path, options: &AssignmentOpt
         path: path.to_path_buf(),
         description: None,
         render,
-        tolerance: super::Tolerance::DEFAULT,
+        tolerance: crate::compare::Tolerance::DEFAULT,
         camera,
         background,
         lights,
@@ -189,13 +189,15 @@ fn render_settings(path: &Path, o: &AssignmentOptions) -> Result<RenderSettings>
         return Err(invalid(format!("-depth {min} {max}: needs finite min < max")));
     }
     Ok(RenderSettings {
-        width: o.width,
-        height: o.height,
-        bounces: o.bounces,
-        shadows: o.shadows,
-        samples: if o.jitter { 16 } else { 1 },
-        seed: 0,
-        filter: if o.filter { Filter::Gaussian } else { Filter::None },
+        trace: Trace {
+            width: o.width,
+            height: o.height,
+            bounces: o.bounces,
+            shadows: o.shadows,
+            samples: if o.jitter { 16 } else { 1 },
+            seed: 0,
+            filter: if o.filter { Filter::Gaussian } else { Filter::None },
+        },
         depth_range: o.depth_range,
         normals: o.normals,
         tonemap: Tonemap::Clamp,

@@ -9,7 +9,6 @@ use std::path::{Path, PathBuf};
 
 use super::spec::{BackgroundSpec, Case, LightSpec, ObjectSpec, ShapeSpec, TransformOp};
 use super::{LoadOptions, parse};
-use crate::film::Tonemap;
 use crate::options::Profile;
 
 /// `toml_path` is where the file will live: asset paths are written relative to its directory
@@ -19,11 +18,28 @@ pub fn case_to_toml(case: &Case, toml_path: &Path) -> String {
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
+    write_case(case, Some(base))
+}
+
+/// [`case_to_toml`] for a file whose location is unknown (standard output, which may be
+/// redirected anywhere): asset paths are absolute, so the case loads wherever it is saved.
+pub fn case_to_toml_anywhere(case: &Case) -> String {
+    write_case(case, None)
+}
+
+/// Asset paths relative to `base`, or absolute without one.
+fn write_case(case: &Case, base: Option<&Path>) -> String {
     let writer = Writer { case, base };
     let defaults = defaults(case.render.profile);
+    let paths = match base {
+        Some(_) => "Paths are relative to this file",
+        None => {
+            "Paths are absolute (it was written to standard output; `goldray import -o FILE` writes \
+             them relative to FILE)"
+        }
+    };
     let mut out = format!(
-        "# Imported from {} by goldray.\n# Paths are relative to this file; keys left out take \
-         their default values.\n",
+        "# Imported from {} by goldray.\n# {paths}; keys left out take their default values.\n",
         writer.path(&case.path)
     );
     if let Some(description) = &case.description {
@@ -79,7 +95,7 @@ fn defaults(profile: Profile) -> Case {
     let skeleton = format!(
         "[render]\nprofile = {}\n[camera]\ncenter = [0, 0, 0]\ndirection = [0, 0, -1]\n\
          up = [0, 1, 0]\nfov = 30\n[materials.m]\n",
-        string(profile_name(profile))
+        string(profile.name())
     );
     parse(&skeleton, Path::new("defaults.toml"), &LoadOptions::default())
         .expect("the skeleton case is valid for every profile")
@@ -87,7 +103,8 @@ fn defaults(profile: Profile) -> Case {
 
 struct Writer<'a> {
     case: &'a Case,
-    base: &'a Path,
+    /// Where asset paths are relative to; `None`: they are absolute.
+    base: Option<&'a Path>,
 }
 
 impl Writer<'_> {
@@ -95,22 +112,38 @@ impl Writer<'_> {
         let (r, d) = (&self.case.render, &defaults.render);
         let mut out = format!(
             "\n[render]\nprofile = {}\nsize = [{}, {}]\n",
-            string(profile_name(r.profile)),
-            r.width,
-            r.height
+            string(r.profile.name()),
+            r.trace.width,
+            r.trace.height
         );
         let depth = |range: Option<(f64, f64)>| {
             range.map_or_else(String::new, |(min, max)| format!("[{}, {}]", number(min), number(max)))
         };
         out += &only_changed(&[
-            ("bounces", r.bounces != d.bounces, r.bounces.to_string()),
-            ("shadows", r.shadows != d.shadows, r.shadows.to_string()),
-            ("samples", r.samples != d.samples, r.samples.to_string()),
-            ("seed", r.seed != d.seed, r.seed.to_string()),
-            ("filter", r.filter != d.filter, string(r.filter.name())),
+            (
+                "bounces",
+                r.trace.bounces != d.trace.bounces,
+                r.trace.bounces.to_string(),
+            ),
+            (
+                "shadows",
+                r.trace.shadows != d.trace.shadows,
+                r.trace.shadows.to_string(),
+            ),
+            (
+                "samples",
+                r.trace.samples != d.trace.samples,
+                r.trace.samples.to_string(),
+            ),
+            ("seed", r.trace.seed != d.trace.seed, r.trace.seed.to_string()),
+            (
+                "filter",
+                r.trace.filter != d.trace.filter,
+                string(r.trace.filter.name()),
+            ),
             ("depth_range", r.depth_range != d.depth_range, depth(r.depth_range)),
             ("normals", r.normals != d.normals, r.normals.to_string()),
-            ("tonemap", r.tonemap != d.tonemap, string(tonemap_name(r.tonemap))),
+            ("tonemap", r.tonemap != d.tonemap, string(r.tonemap.name())),
             ("precision", r.precision != d.precision, string(r.precision.name())),
         ]);
         out
@@ -208,7 +241,7 @@ impl Writer<'_> {
     }
 
     fn path(&self, path: &Path) -> String {
-        relative(path, self.base).unwrap_or_else(|| {
+        self.base.and_then(|base| relative(path, base)).unwrap_or_else(|| {
             lexical_absolute(path)
                 .unwrap_or_else(|| path.to_path_buf())
                 .to_string_lossy()
@@ -348,18 +381,4 @@ fn string(s: &str) -> String {
 fn key(name: &str) -> String {
     let bare = !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
     if bare { name.to_owned() } else { string(name) }
-}
-
-fn profile_name(profile: Profile) -> &'static str {
-    match profile {
-        Profile::Native => "native",
-        Profile::Mit6837 => "mit6837",
-    }
-}
-
-fn tonemap_name(tonemap: Tonemap) -> &'static str {
-    match tonemap {
-        Tonemap::Srgb => "srgb",
-        Tonemap::Clamp => "clamp",
-    }
 }

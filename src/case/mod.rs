@@ -17,25 +17,21 @@ mod tests;
 
 use std::path::Path;
 
-use toml::de::DeTable;
-
+pub use crate::located_toml::SourceLocation;
 pub use assignment::{AssignmentOptions, load_assignment_scene, parse_assignment_scene};
-pub use error::{CaseError, SourceLocation};
-pub use export::case_to_toml;
-pub use sections::{MAX_BOUNCES, MAX_IMAGE_SIZE};
+pub use error::CaseError;
+pub use export::{case_to_toml, case_to_toml_anywhere};
+pub use sections::MAX_BOUNCES;
 pub use spec::{
-    BackgroundSpec, CameraSpec, Case, LightSpec, MaterialSpec, ObjectSpec, RenderSettings, ShapeSpec, Tolerance,
-    TransformOp, composite_matrix,
+    BackgroundSpec, CameraSpec, Case, LightSpec, MaterialSpec, ObjectSpec, RenderSettings, ShapeSpec, TransformOp,
+    composite_matrix,
 };
 
-// The located TOML readers and the key suggestions, shared with the grading rubric so that both
-// files report mistakes the same way.
-pub(crate) use error::suggest;
-pub(crate) use value::{Doc, Field, Table};
+use crate::located_toml::{self, Doc, Table};
 
 #[derive(Clone, Debug, Default)]
 pub struct LoadOptions {
-    /// Lifts the `MAX_IMAGE_SIZE` guard (the CLI's `--force`).
+    /// Lifts the [`crate::image_size::MAX_IMAGE_SIZE`] guard (the CLI's `--force`).
     pub allow_huge_images: bool,
 }
 
@@ -60,15 +56,11 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<Case, CaseError> {
 
 /// `path` is not read: it names the case in messages and anchors its relative asset paths.
 pub fn parse(source: &str, path: &Path, options: &LoadOptions) -> Result<Case, CaseError> {
-    let root = DeTable::parse(source).map_err(|e| CaseError::Syntax {
-        location: SourceLocation::from_offset(path, source, e.span().map_or(0, |s| s.start)),
-        message: e.message().to_owned(),
-    })?;
+    let root = located_toml::parse(source, path)?;
     let doc = Doc {
         file: path,
         text: source,
         dir: path.parent().unwrap_or(Path::new("")),
-        options,
     };
     let top = Table::new(&doc, "the case file".to_owned(), root.span(), root.get_ref());
     top.check_keys(TOP_LEVEL_KEYS)?;
@@ -77,7 +69,7 @@ pub fn parse(source: &str, path: &Path, options: &LoadOptions) -> Result<Case, C
         name: case_name(path),
         path: path.to_path_buf(),
         description: top.read("description", None, |f| f.string().map(|s| Some(s.to_owned())))?,
-        render: sections::render(&doc, top.get("render"))?,
+        render: sections::render(&doc, top.get("render"), options)?,
         tolerance: sections::tolerance(&doc, top.get("tolerance"))?,
         camera: sections::camera(&doc, top.get("camera"))?,
         background: sections::background(&doc, top.get("background"))?,
@@ -88,7 +80,7 @@ pub fn parse(source: &str, path: &Path, options: &LoadOptions) -> Result<Case, C
 }
 
 /// A case is named after its file's stem: `cases/spheres.toml` renders `spheres.exr`.
-pub(crate) fn case_name(path: &Path) -> String {
+pub fn case_name(path: &Path) -> String {
     path.file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_default()

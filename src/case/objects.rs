@@ -5,9 +5,9 @@ use std::path::{Path, PathBuf};
 
 use glam::{DMat3, DVec4};
 
-use super::error::suggest;
 use super::spec::{MaterialSpec, ObjectSpec, ShapeSpec, TransformOp, composite_matrix};
-use super::value::{Field, Result};
+use super::value::SceneValues;
+use crate::located_toml::{Field, Result, suggest};
 
 #[derive(Clone, Copy)]
 enum Kind {

@@ -5,15 +5,16 @@ use std::path::Path;
 
 use glam::DVec3;
 
+use super::LoadOptions;
 use super::error::CaseError;
-use super::spec::{BackgroundSpec, CameraSpec, LightSpec, MaterialSpec, RenderSettings, Tolerance};
-use super::value::{Doc, Field, Result, Table};
+use super::spec::{BackgroundSpec, CameraSpec, LightSpec, MaterialSpec, RenderSettings};
+use super::value::SceneValues;
+use crate::compare::Tolerance;
 use crate::film::Tonemap;
-use crate::options::Profile;
+use crate::image_size::{SizeLimit, check_side};
+use crate::located_toml::{Doc, Field, Result, Table};
+use crate::options::{Profile, Trace};
 
-/// Beyond this a typo (an extra digit) is likelier than intent, and the film would need
-/// gigabytes; `--force` lifts it.
-pub const MAX_IMAGE_SIZE: i64 = 16384;
 /// Deeper recursion cannot change an 8-bit image and only risks runaway render times.
 pub const MAX_BOUNCES: i64 = 1024;
 /// Faces of a cube-map directory, as the assignment names them.
@@ -24,7 +25,11 @@ fn section<'a, 'i>(doc: &'a Doc<'a>, field: Option<Field<'a, 'i>>, what: &str) -
     field.map_or_else(|| Ok(Table::empty(doc, what)), |f| f.table(what.to_owned()))
 }
 
-pub(crate) fn render<'a>(doc: &'a Doc<'a>, field: Option<Field<'a, '_>>) -> Result<RenderSettings> {
+pub(crate) fn render<'a>(
+    doc: &'a Doc<'a>,
+    field: Option<Field<'a, '_>>,
+    options: &LoadOptions,
+) -> Result<RenderSettings> {
     let t = section(doc, field, "[render]")?;
     t.check_keys(&[
         "size",
@@ -39,7 +44,7 @@ pub(crate) fn render<'a>(doc: &'a Doc<'a>, field: Option<Field<'a, '_>>) -> Resu
         "profile",
         "precision",
     ])?;
-    let (width, height) = t.read("size", (200, 200), |f| size(doc, f))?;
+    let (width, height) = t.read("size", (200, 200), |f| size(f, options))?;
     let profile = t.read("profile", Profile::Native, Field::variant)?;
     // The assignment quantises with trunc(c·255) and no gamma; a mit6837 case that did not ask
     // for a tone map wants to match the reference images, not look nicer.
@@ -48,15 +53,17 @@ pub(crate) fn render<'a>(doc: &'a Doc<'a>, field: Option<Field<'a, '_>>) -> Resu
         Profile::Mit6837 => Tonemap::Clamp,
     };
     Ok(RenderSettings {
-        width,
-        height,
-        bounces: t.read("bounces", 0, |f| {
-            f.integer_in(0..=MAX_BOUNCES, &format!("must be between 0 and {MAX_BOUNCES}"))
-        })?,
-        shadows: t.read("shadows", false, Field::boolean)?,
-        samples: t.read("samples", 1, samples)?,
-        seed: t.read("seed", 0, |f| f.integer_in(0..=i64::MAX, "must be ≥ 0"))?,
-        filter: t.read("filter", Default::default(), Field::variant)?,
+        trace: Trace {
+            width,
+            height,
+            bounces: t.read("bounces", 0, |f| {
+                f.integer_in(0..=MAX_BOUNCES, &format!("must be between 0 and {MAX_BOUNCES}"))
+            })?,
+            shadows: t.read("shadows", false, Field::boolean)?,
+            samples: t.read("samples", 1, samples)?,
+            seed: t.read("seed", 0, |f| f.integer_in(0..=i64::MAX, "must be ≥ 0"))?,
+            filter: t.read("filter", Default::default(), Field::variant)?,
+        },
         depth_range: t.read("depth_range", None, |f| {
             let [min, max] = f.numbers("an array of 2 numbers [min, max]")?;
             if min < max {
@@ -72,7 +79,7 @@ pub(crate) fn render<'a>(doc: &'a Doc<'a>, field: Option<Field<'a, '_>>) -> Resu
     })
 }
 
-fn size(doc: &Doc, f: &Field) -> Result<(u32, u32)> {
+fn size(f: &Field, options: &LoadOptions) -> Result<(u32, u32)> {
     let mut items = f.array("an array of 2 integers [width, height]")?;
     if items.len() != 2 {
         let n = items.len();
@@ -82,12 +89,12 @@ fn size(doc: &Doc, f: &Field) -> Result<(u32, u32)> {
     items[1].name = "height".to_owned();
     let mut out = [0; 2];
     for (slot, item) in out.iter_mut().zip(&items) {
-        *slot = if doc.options.allow_huge_images {
-            item.integer_in(1..=i64::from(u32::MAX), "must be between 1 and 4294967295")?
+        let limit = if options.allow_huge_images {
+            SizeLimit::Lifted
         } else {
-            let requirement = format!("must be between 1 and {MAX_IMAGE_SIZE} (pass --force to render larger images)");
-            item.integer_in(1..=MAX_IMAGE_SIZE, &requirement)?
+            SizeLimit::Forceable
         };
+        *slot = check_side(item.integer()?, limit).map_err(|error| item.invalid(error.to_string()))?;
     }
     Ok((out[0], out[1]))
 }
@@ -135,7 +142,8 @@ pub(crate) fn tolerance<'a>(doc: &'a Doc<'a>, field: Option<Field<'a, '_>>) -> R
     })
 }
 
-pub(crate) fn camera(doc: &Doc, field: Option<Field>) -> Result<CameraSpec> {
+/// The one section a case cannot do without, hence the one that can be missing.
+pub(crate) fn camera(doc: &Doc, field: Option<Field>) -> std::result::Result<CameraSpec, CaseError> {
     let Some(field) = field else {
         return Err(CaseError::Missing {
             file: doc.file.to_path_buf(),
@@ -151,12 +159,14 @@ pub(crate) fn camera(doc: &Doc, field: Option<Field>) -> Result<CameraSpec> {
     let up = up_field.direction()?;
     if is_parallel(direction, up) {
         let d = direction_field.excerpt();
-        return Err(up_field.invalid(format!("must not be parallel to direction {d}")));
+        return Err(up_field
+            .invalid(format!("must not be parallel to direction {d}"))
+            .into());
     }
     let fov_field = t.require("fov")?;
     let fov = fov_field.number()?;
     if fov <= 0.0 || fov >= 180.0 {
-        return Err(fov_field.invalid("must be strictly between 0 and 180 degrees"));
+        return Err(fov_field.invalid("must be strictly between 0 and 180 degrees").into());
     }
     Ok(CameraSpec {
         center,

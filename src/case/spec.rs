@@ -5,9 +5,10 @@ use std::path::PathBuf;
 
 use glam::{DMat4, DVec3};
 
-use super::error::SourceLocation;
+use crate::compare::Tolerance;
 use crate::film::Tonemap;
-use crate::options::{Filter, Precision, Profile};
+use crate::located_toml::SourceLocation;
+use crate::options::{Precision, Profile, Trace};
 
 /// One case file: a scene, how to render it, and how far it may drift from its golden image.
 #[derive(Clone, Debug, PartialEq)]
@@ -28,42 +29,13 @@ pub struct Case {
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
-    pub width: u32,
-    pub height: u32,
-    pub bounces: u32,
-    pub shadows: bool,
-    /// Always a perfect square, so stratified jitter can use an n×n grid.
-    pub samples: u32,
-    pub seed: u64,
-    pub filter: Filter,
+    pub trace: Trace,
     /// `(min, max)` with `min < max`, mapped to black..white in the depth PNG.
     pub depth_range: Option<(f64, f64)>,
     pub normals: bool,
     pub tonemap: Tonemap,
     pub profile: Profile,
     pub precision: Precision,
-}
-
-/// How far a render may drift from golden; all values are non-negative.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Tolerance {
-    pub pixel: f64,
-    /// In [0, 1].
-    pub fail_fraction: f64,
-    pub rmse: f64,
-    /// A hard cap on any single channel's error, for cases where one wrong pixel matters.
-    pub max: Option<f64>,
-}
-
-impl Tolerance {
-    /// What a case without `[tolerance]` gets, and what `goldray diff` applies to two EXRs: one
-    /// definition, so the suite and the command judge alike.
-    pub const DEFAULT: Tolerance = Tolerance {
-        pixel: 0.01,
-        fail_fraction: 0.001,
-        rmse: 0.002,
-        max: None,
-    };
 }
 
 /// `direction` and `up` have nonzero length and are not parallel; `fov` is in (0, 180) degrees.

@@ -1,293 +1,24 @@
-//! Typed, located reads over toml's spanned document tree.
-//!
-//! serde's derive loses spans inside tagged enums and words its own messages, so the case is read
-//! by walking `toml::de::DeTable` by hand: every key and value keeps its byte span, and every
-//! error can name its line and column, quote what was written and say what would be valid.
+//! The case file's own kinds of value, read with the located readers of [`crate::located_toml`]:
+//! points, colours and directions.
 
-use std::fmt;
-use std::ops::{Range, RangeInclusive};
-use std::path::Path;
+use crate::located_toml::{Field, Result};
 
-use serde::de::{DeserializeOwned, IntoDeserializer};
-use toml::Spanned;
-use toml::de::{DeString, DeTable, DeValue};
-
-use super::LoadOptions;
-use super::error::{CaseError, SourceLocation, suggest};
-
-pub(crate) type Result<T> = std::result::Result<T, CaseError>;
-type Value<'i> = Spanned<DeValue<'i>>;
-
-/// What every reader needs to know about the file being read.
-pub(crate) struct Doc<'a> {
-    pub file: &'a Path,
-    pub text: &'a str,
-    /// Relative asset paths are resolved against this, not the working directory.
-    pub dir: &'a Path,
-    pub options: &'a LoadOptions,
+/// Reads of the values a scene is made of. A trait rather than methods of `Field`, because what
+/// makes a colour or a direction valid is the renderer's business, not the TOML reader's.
+pub(crate) trait SceneValues {
+    fn vec3(&self) -> Result<[f64; 3]>;
+    /// Linear RGB; negative light or reflectance has no physical meaning and breaks tone mapping.
+    fn color(&self) -> Result<[f64; 3]>;
+    /// A vector that will be normalised downstream, so its length must survive `1/length`.
+    fn direction(&self) -> Result<[f64; 3]>;
 }
 
-impl Doc<'_> {
-    pub fn location(&self, offset: usize) -> SourceLocation {
-        SourceLocation::from_offset(self.file, self.text, offset)
-    }
-
-    pub fn error_at(&self, span: &Range<usize>, message: impl Into<String>) -> CaseError {
-        CaseError::Invalid {
-            location: self.location(span.start),
-            message: message.into(),
-        }
-    }
-
-    /// What the user wrote at `span`, on one line and short enough to quote in a message.
-    fn excerpt(&self, span: &Range<usize>) -> String {
-        const LIMIT: usize = 60;
-        let raw = self.text.get(span.clone()).unwrap_or("");
-        let one_line = raw.split_whitespace().collect::<Vec<_>>().join(" ");
-        if one_line.chars().count() <= LIMIT {
-            one_line
-        } else {
-            one_line.chars().take(LIMIT - 1).chain(['…']).collect()
-        }
-    }
-}
-
-/// A TOML table plus the name it goes by in messages ("[render]", "sphere", "point light").
-pub(crate) struct Table<'a, 'i> {
-    pub doc: &'a Doc<'a>,
-    pub what: String,
-    pub span: Range<usize>,
-    /// Sorted by position, so that the first problem reported is the first one in the file.
-    entries: Vec<(&'a Spanned<DeString<'i>>, &'a Value<'i>)>,
-}
-
-impl<'a, 'i> Table<'a, 'i> {
-    pub fn new(doc: &'a Doc<'a>, what: String, span: Range<usize>, table: &'a DeTable<'i>) -> Self {
-        let mut entries: Vec<_> = table.iter().collect();
-        entries.sort_by_key(|(key, _)| key.span().start);
-        Table {
-            doc,
-            what,
-            span,
-            entries,
-        }
-    }
-
-    /// Stands in for an absent optional section, so that it reads as all defaults.
-    pub fn empty(doc: &'a Doc<'a>, what: &str) -> Self {
-        Table {
-            doc,
-            what: what.to_owned(),
-            span: 0..0,
-            entries: Vec::new(),
-        }
-    }
-
-    pub fn fields(&self) -> impl Iterator<Item = Field<'a, 'i>> + '_ {
-        self.entries.iter().map(|&(key, value)| Field {
-            doc: self.doc,
-            name: key.get_ref().to_string(),
-            key_span: key.span(),
-            value,
-        })
-    }
-
-    pub fn get(&self, name: &str) -> Option<Field<'a, 'i>> {
-        self.fields().find(|f| f.name == name)
-    }
-
-    pub fn require(&self, name: &str) -> Result<Field<'a, 'i>> {
-        self.get(name).ok_or_else(|| {
-            self.doc
-                .error_at(&self.span, format!("{} is missing required key `{name}`", self.what))
-        })
-    }
-
-    pub fn check_keys(&self, allowed: &[&str]) -> Result<()> {
-        self.check_keys_with(allowed, |_| None)
-    }
-
-    /// Rejects the first key not in `allowed`. `owner` names the other kinds a stray key belongs
-    /// to, because `offset` on a sphere is a different mistake from a typo and deserves a
-    /// different hint.
-    pub fn check_keys_with(&self, allowed: &[&str], owner: impl Fn(&str) -> Option<String>) -> Result<()> {
-        let Some(field) = self.fields().find(|f| !allowed.contains(&f.name.as_str())) else {
-            return Ok(());
-        };
-        let (name, what) = (&field.name, &self.what);
-        let message = match owner(name) {
-            Some(kinds) => format!(
-                "key `{name}` does not apply to a {what} (it is a {kinds} key); valid keys for a \
-                 {what}: {}",
-                allowed.join(", ")
-            ),
-            None => format!("unknown key `{name}` in {what}{}", suggest(name, allowed, "keys")),
-        };
-        Err(self.doc.error_at(&field.key_span, message))
-    }
-
-    /// Reads the required `kind` string of a tagged table (an object or a light), renames the
-    /// table after it, and checks the keys against `common` plus that kind's own.
-    pub fn kind<K: Copy>(&mut self, noun: &str, common: &[&str], kinds: &[(&str, &[&str], K)]) -> Result<K> {
-        let field = self.require("kind")?;
-        let written = field.string()?;
-        let Some(&(name, own, kind)) = kinds.iter().find(|(k, _, _)| *k == written) else {
-            let names: Vec<&str> = kinds.iter().map(|(k, _, _)| *k).collect();
-            let tail = suggest(written, &names, "kinds");
-            return Err(field.error(format!("unknown {noun} kind `{written}`{tail}")));
-        };
-        // "in sphere" reads naturally, "in point" does not: only lights keep their noun.
-        self.what = if noun == "object" {
-            name.to_owned()
-        } else {
-            format!("{name} {noun}")
-        };
-        let allowed: Vec<&str> = common.iter().chain(own).copied().collect();
-        self.check_keys_with(&allowed, |key| {
-            let owners: Vec<&str> = kinds
-                .iter()
-                .filter(|(_, keys, _)| keys.contains(&key))
-                .map(|(k, _, _)| *k)
-                .collect();
-            (!owners.is_empty()).then(|| owners.join("/"))
-        })?;
-        Ok(kind)
-    }
-
-    /// `read` applied to the key if present, else `default`: how every optional setting is read.
-    pub fn read<T>(&self, name: &str, default: T, read: impl FnOnce(&Field<'a, 'i>) -> Result<T>) -> Result<T> {
-        self.get(name).map_or(Ok(default), |f| read(&f))
-    }
-}
-
-/// One value with the key (or `key[index]`) it was found under.
-pub(crate) struct Field<'a, 'i> {
-    pub doc: &'a Doc<'a>,
-    pub name: String,
-    pub key_span: Range<usize>,
-    value: &'a Value<'i>,
-}
-
-impl<'a, 'i> Field<'a, 'i> {
-    pub fn span(&self) -> Range<usize> {
-        self.value.span()
-    }
-
-    pub fn excerpt(&self) -> String {
-        self.doc.excerpt(&self.span())
-    }
-
-    pub fn error(&self, message: impl Into<String>) -> CaseError {
-        self.doc.error_at(&self.span(), message)
-    }
-
-    /// "`requirement`, found `what was written`", the shape of nearly every value error.
-    pub fn invalid(&self, requirement: impl fmt::Display) -> CaseError {
-        self.error(format!("{} {requirement}, found {}", self.name, self.excerpt()))
-    }
-
-    fn wrong_type(&self, expected: &str) -> CaseError {
-        let found = self.value.get_ref().type_str();
-        self.error(format!(
-            "{} must be {expected}, found {found} {}",
-            self.name,
-            self.excerpt()
-        ))
-    }
-
-    /// Any finite number; TOML integers count, because `fov = 30` is what people write.
-    pub fn number(&self) -> Result<f64> {
-        let value = match self.value.get_ref() {
-            DeValue::Integer(_) => self.integer()? as f64,
-            DeValue::Float(f) => f.as_str().parse::<f64>().map_err(|_| self.wrong_type("a number"))?,
-            _ => return Err(self.wrong_type("a number")),
-        };
-        if value.is_finite() {
-            Ok(value)
-        } else {
-            Err(self.invalid("must be a finite number"))
-        }
-    }
-
-    pub fn integer(&self) -> Result<i64> {
-        let DeValue::Integer(i) = self.value.get_ref() else {
-            return Err(self.wrong_type("an integer"));
-        };
-        i64::from_str_radix(i.as_str(), i.radix()).map_err(|_| self.invalid("must be an integer that fits in 64 bits"))
-    }
-
-    /// An integer in `range`, converted to the type the renderer stores it in.
-    pub fn integer_in<T: TryFrom<i64>>(&self, range: RangeInclusive<i64>, requirement: &str) -> Result<T> {
-        let value = self.integer()?;
-        match T::try_from(value) {
-            Ok(v) if range.contains(&value) => Ok(v),
-            _ => Err(self.invalid(requirement)),
-        }
-    }
-
-    pub fn non_negative(&self) -> Result<f64> {
-        let value = self.number()?;
-        if value >= 0.0 {
-            Ok(value)
-        } else {
-            Err(self.invalid("must be ≥ 0"))
-        }
-    }
-
-    pub fn boolean(&self) -> Result<bool> {
-        self.value
-            .get_ref()
-            .as_bool()
-            .ok_or_else(|| self.wrong_type("true or false"))
-    }
-
-    pub fn string(&self) -> Result<&'a str> {
-        self.value.get_ref().as_str().ok_or_else(|| self.wrong_type("a string"))
-    }
-
-    pub fn table(&self, what: String) -> Result<Table<'a, 'i>> {
-        match self.value.get_ref() {
-            DeValue::Table(t) => Ok(Table::new(self.doc, what, self.span(), t)),
-            _ => Err(self.wrong_type("a table")),
-        }
-    }
-
-    /// The elements, each named `name[i]` so that its own errors point inside the array.
-    pub fn array(&self, expected: &str) -> Result<Vec<Field<'a, 'i>>> {
-        let DeValue::Array(items) = self.value.get_ref() else {
-            return Err(self.wrong_type(expected));
-        };
-        Ok(items
-            .iter()
-            .enumerate()
-            .map(|(i, value)| Field {
-                doc: self.doc,
-                name: format!("{}[{i}]", self.name),
-                key_span: value.span(),
-                value,
-            })
-            .collect())
-    }
-
-    pub fn numbers<const N: usize>(&self, expected: &str) -> Result<[f64; N]> {
-        let items = self.array(expected)?;
-        if items.len() != N {
-            let n = items.len();
-            return Err(self.invalid(format!("must be {expected}, but has {n} elements")));
-        }
-        let mut out = [0.0; N];
-        for (slot, item) in out.iter_mut().zip(&items) {
-            *slot = item.number()?;
-        }
-        Ok(out)
-    }
-
-    pub fn vec3(&self) -> Result<[f64; 3]> {
+impl SceneValues for Field<'_, '_> {
+    fn vec3(&self) -> Result<[f64; 3]> {
         self.numbers("an array of 3 numbers [x, y, z]")
     }
 
-    /// Linear RGB; negative light or reflectance has no physical meaning and breaks tone mapping.
-    pub fn color(&self) -> Result<[f64; 3]> {
+    fn color(&self) -> Result<[f64; 3]> {
         let rgb: [f64; 3] = self.numbers("an array of 3 numbers [r, g, b]")?;
         match rgb.iter().position(|c| *c < 0.0) {
             Some(i) => Err(self.array("")?[i].invalid("must be ≥ 0 (colours are non-negative)")),
@@ -295,24 +26,13 @@ impl<'a, 'i> Field<'a, 'i> {
         }
     }
 
-    /// A vector that will be normalised downstream, so its length must survive `1/length`.
-    pub fn direction(&self) -> Result<[f64; 3]> {
+    fn direction(&self) -> Result<[f64; 3]> {
         let v = self.vec3()?;
         if has_usable_length(v) {
             Ok(v)
         } else {
             Err(self.invalid("must have a nonzero, finite length"))
         }
-    }
-
-    /// A string naming a variant of one of the crate's serde enums. The valid names come from the
-    /// enum's own derive, so they cannot drift from what the renderer accepts.
-    pub fn variant<T: DeserializeOwned>(&self) -> Result<T> {
-        let written = self.string()?;
-        T::deserialize(IntoDeserializer::<VariantError>::into_deserializer(written)).map_err(|e| {
-            let tail = suggest(written, e.expected, "values");
-            self.error(format!("unknown {} `{written}`{tail}", self.name))
-        })
     }
 }
 
@@ -321,28 +41,4 @@ impl<'a, 'i> Field<'a, 'i> {
 pub(crate) fn has_usable_length(v: [f64; 3]) -> bool {
     let length = glam::DVec3::from(v).length();
     length > 0.0 && length.is_finite() && (1.0 / length).is_finite()
-}
-
-/// Captures the variant list that serde's derive hands to `unknown_variant`.
-#[derive(Debug)]
-struct VariantError {
-    expected: &'static [&'static str],
-}
-
-impl fmt::Display for VariantError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "expected one of {}", self.expected.join(", "))
-    }
-}
-
-impl std::error::Error for VariantError {}
-
-impl serde::de::Error for VariantError {
-    fn custom<T: fmt::Display>(_: T) -> Self {
-        VariantError { expected: &[] }
-    }
-
-    fn unknown_variant(_: &str, expected: &'static [&'static str]) -> Self {
-        VariantError { expected }
-    }
 }

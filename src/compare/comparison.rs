@@ -7,8 +7,8 @@ use serde::Serialize;
 
 use super::image::{COLOR_CHANNELS, Encoding, Image};
 use super::metrics::{Metrics, measure, same_layout};
+use super::tolerance::Tolerance;
 use super::verdict::{Layout, Verdict, judge, percent};
-use crate::case::Tolerance;
 
 /// The outcome of comparing `actual` against `expected`. `metrics` is `None` only for a
 /// [`Verdict::Mismatch`].

@@ -15,19 +15,21 @@
 //! # }
 //! ```
 
-mod cli;
 mod comparison;
 mod error;
+mod files;
 mod flip;
 mod heatmap;
 mod image;
 mod metrics;
+mod tolerance;
 mod verdict;
 
-pub use cli::{DiffArgs, EXR_DEFAULTS, PNG_DEFAULTS, UNREADABLE, diff_files, run_diff};
 pub use comparison::{Comparison, compare};
 pub use error::CompareError;
+pub use files::{FileComparison, ToleranceOverrides, compare_files};
 pub use heatmap::{FAILING, NON_FINITE, diff_heatmap};
 pub use image::{COLOR_CHANNELS, Channel, Encoding, Image};
 pub use metrics::{ChannelStats, Metrics, NonFinite, PixelError};
+pub use tolerance::{EXR_DEFAULTS, PNG_DEFAULTS, Tolerance};
 pub use verdict::{Breach, Layout, Limit, Verdict};

@@ -17,7 +17,7 @@ use serde::Serialize;
 
 use super::image::{Encoding, Image};
 use super::metrics::{Metrics, PixelError, largest};
-use crate::case::Tolerance;
+use super::tolerance::Tolerance;
 
 /// The limit of a [`Tolerance`] that a comparison broke.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]

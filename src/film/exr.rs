@@ -12,7 +12,8 @@ use ::exr::prelude::{
 };
 
 use super::Film;
-use super::output::{OutputError, write_file_atomic};
+use super::error::OutputError;
+use crate::atomic_write::write_file_atomic;
 
 /// What in-memory EXR bytes are called in messages, where there is no file path to name.
 const IN_MEMORY: &str = "EXR data";
@@ -55,7 +56,7 @@ pub fn read_exr(path: &Path) -> Result<Film, OutputError> {
 /// [`encode_exr`] written atomically: a reader sees the old file or the new one, never a part.
 pub fn write_exr(path: &Path, film: &Film) -> Result<(), OutputError> {
     let bytes = encode_exr_named(film, &path.display().to_string())?;
-    write_file_atomic(path, &bytes)
+    Ok(write_file_atomic(path, &bytes)?)
 }
 
 /// [`encode_exr`] with `file` (the destination) named in its errors.

@@ -1,15 +1,15 @@
 //! The rendered image and its outputs: HDR colour plus the depth and normal AOVs, written as one
 //! linear EXR and as tone-mapped PNGs.
 
-use serde::Deserialize;
-
+mod error;
 mod exr;
 mod output;
 mod png;
 
+pub use self::error::OutputError;
 pub use self::exr::{decode_exr, encode_exr, read_exr, write_exr};
-pub use self::output::{OutputError, OutputOptions, encode_png, write_file_atomic, write_outputs, write_png};
-pub use self::png::{color_image, depth_image, normals_image};
+pub use self::output::{OutputOptions, write_outputs};
+pub use self::png::{color_image, depth_image, encode_png, normals_image, write_png};
 
 /// A rendered frame. Pixels are row-major with row 0 at the top of the picture.
 ///
@@ -44,12 +44,12 @@ impl Film {
     }
 }
 
-/// How linear colour becomes 8-bit PNG values.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Tonemap {
-    /// Clamp to [0, 1], apply the sRGB transfer curve, round to nearest.
-    Srgb,
-    /// The assignment's quantisation: `trunc(c·255)` clamped to [0, 255], no gamma.
-    Clamp,
+crate::named_enum::named_enum! {
+    /// How linear colour becomes 8-bit PNG values.
+    pub enum Tonemap: "tone map" {
+        /// Clamp to [0, 1], apply the sRGB transfer curve, round to nearest.
+        Srgb = "srgb",
+        /// The assignment's quantisation: `trunc(c·255)` clamped to [0, 255], no gamma.
+        Clamp = "clamp",
+    }
 }

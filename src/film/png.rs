@@ -1,10 +1,15 @@
-//! 8-bit previews of the film. Colour goes through the case's tone map; depth and normals are data,
+//! 8-bit PNG previews of the film, and their encoding. Colour goes through the case's tone map; depth and normals are data,
 //! so they skip the sRGB curve but keep the tone map's rounding rule, which lets the `clamp`
 //! (assignment) profile reproduce the reference renderer's depth and normal PNGs value for value.
 
-use image::{Rgb, RgbImage};
+use std::io::Cursor;
+use std::path::Path;
 
+use image::{ImageFormat, Rgb, RgbImage};
+
+use super::error::OutputError;
 use super::{Film, Tonemap};
+use crate::atomic_write::write_file_atomic;
 
 /// Colour as the case asks: `Srgb` for viewing, `Clamp` for the assignment's `trunc(c·255)`.
 pub fn color_image(film: &Film, tonemap: Tonemap) -> RgbImage {
@@ -77,6 +82,28 @@ fn srgb_encode(linear: f32) -> f32 {
     } else {
         1.055 * linear.powf(1.0 / 2.4) - 0.055
     }
+}
+
+/// Lossless 8-bit RGB PNG bytes.
+pub fn encode_png(image: &RgbImage) -> Result<Vec<u8>, OutputError> {
+    encode_png_named(image, "PNG data")
+}
+
+/// [`encode_png`] written with [`write_file_atomic`].
+pub fn write_png(path: &Path, image: &RgbImage) -> Result<(), OutputError> {
+    let bytes = encode_png_named(image, &path.display().to_string())?;
+    Ok(write_file_atomic(path, &bytes)?)
+}
+
+pub(super) fn encode_png_named(image: &RgbImage, file: &str) -> Result<Vec<u8>, OutputError> {
+    let mut bytes = Cursor::new(Vec::new());
+    image
+        .write_to(&mut bytes, ImageFormat::Png)
+        .map_err(|source| OutputError::EncodePng {
+            file: file.to_owned(),
+            source,
+        })?;
+    Ok(bytes.into_inner())
 }
 
 #[cfg(test)]

@@ -7,14 +7,11 @@
 mod build;
 mod collapse;
 
-use std::time::Duration;
-
 use smallvec::SmallVec;
 
 use super::Ray;
 use super::aabb::{Aabb, SlabRay, hit_lanes};
 use super::real::Real;
-use crate::stats::BvhStats;
 
 /// Children per node: four boxes are tested at once, one per SIMD lane.
 const WIDTH: usize = 4;
@@ -131,9 +128,9 @@ impl Bvh {
         &self.prim_indices
     }
 
-    /// Its shape for `--stats`.
-    pub fn stats(&self, build_time: Duration) -> BvhStats {
-        BvhStats { build_time, primitives: self.prim_indices().len(), nodes: self.node_count(), leaves: self.leaf_count() }
+    /// Number of primitives, each in exactly one leaf.
+    pub fn primitive_count(&self) -> usize {
+        self.prim_indices.len()
     }
 
     /// Number of (4-wide) nodes.

@@ -5,30 +5,15 @@
 use std::io;
 use std::path::PathBuf;
 
-use crate::case::{CaseError, SourceLocation};
+use crate::case::CaseError;
 use crate::film::OutputError;
+use crate::located_toml::{LocatedError, SourceLocation};
 
 #[derive(Debug, thiserror::Error)]
 pub enum GradeError {
-    #[error("{}: cannot read the rubric: {source}", path.display())]
-    ReadRubric {
-        path: PathBuf,
-        #[source]
-        source: io::Error,
-    },
-
-    /// A mistake inside the rubric, located at `file:line:column`.
+    /// The rubric cannot be read, has a mistake, or names a render that does not load.
     #[error(transparent)]
-    Rubric(#[from] CaseError),
-
-    /// The case or course scene a `[render.NAME]` table points at does not load.
-    #[error("{location}: render `{render}`: {source}")]
-    Source {
-        location: SourceLocation,
-        render: String,
-        #[source]
-        source: Box<CaseError>,
-    },
+    Rubric(#[from] RubricError),
 
     #[error("{location}: render `{render}` cannot be rendered: {source}")]
     Golden {
@@ -50,4 +35,32 @@ pub enum GradeError {
 
     #[error("cannot start worker threads: {0}")]
     Threads(#[from] rayon::ThreadPoolBuildError),
+}
+
+/// Why a rubric could not be loaded, found before anything renders.
+#[derive(Debug, thiserror::Error)]
+pub enum RubricError {
+    #[error("{}: cannot read the rubric: {source}", path.display())]
+    Read {
+        path: PathBuf,
+        #[source]
+        source: io::Error,
+    },
+
+    /// A mistake inside the rubric, located at `file:line:column`.
+    #[error(transparent)]
+    Toml(#[from] LocatedError),
+
+    /// Something absent from the rubric, which therefore has no line to point at.
+    #[error("{}: {message}", file.display())]
+    Missing { file: PathBuf, message: String },
+
+    /// The case or course scene a `[render.NAME]` table points at does not load.
+    #[error("{location}: render `{render}`: {source}")]
+    Source {
+        location: SourceLocation,
+        render: String,
+        #[source]
+        source: Box<CaseError>,
+    },
 }

@@ -21,12 +21,12 @@ use serde::Serialize;
 
 use super::error::GradeError;
 use super::rubric::{Output, Rubric};
+use crate::atomic_write::write_file_atomic;
 use crate::case::{Case, ObjectSpec, ShapeSpec};
 use crate::compare::Image;
-use crate::film::{
-    Film, color_image, decode_exr, depth_image, encode_exr, normals_image, write_file_atomic, write_png,
-};
-use crate::pipeline::render_case;
+use crate::film::{Film, color_image, decode_exr, depth_image, encode_exr, normals_image, write_png};
+use crate::pipeline::render_case_reporting;
+use crate::progress::Progress;
 
 /// Where the report keeps the golden PNGs, relative to the report directory.
 pub const GOLDEN_DIR: &str = "golden";
@@ -52,13 +52,25 @@ pub struct Goldens {
     pub images: Vec<Image>,
 }
 
+/// Where golden renders are cached unless the caller says otherwise: the user's cache folder
+/// (`$XDG_CACHE_HOME/goldray/goldens`, usually `~/.cache/goldray/goldens`, on Linux;
+/// `~/Library/Caches/goldray/goldens` on macOS), or the system's temporary folder when there is
+/// none. Outside the report, so that zipping a report to send it does not drag the cache along;
+/// shared by every report, which is safe because entries are named by a hash of their content.
+pub fn default_cache_dir() -> PathBuf {
+    dirs::cache_dir()
+        .unwrap_or_else(std::env::temp_dir)
+        .join("goldray")
+        .join("goldens")
+}
+
 /// Renders (or loads from `cache_dir`) every render an image uses, and writes each golden picture
 /// to `REPORT/golden/FILE` for the HTML report.
 pub fn prepare_goldens(
     rubric: &Rubric,
     cache_dir: &Path,
     report_dir: &Path,
-    show_progress: bool,
+    progress: &dyn Progress,
 ) -> Result<Goldens, GradeError> {
     let mut films: HashMap<usize, Film> = HashMap::new();
     let mut by_key: HashMap<String, usize> = HashMap::new();
@@ -81,7 +93,11 @@ pub fn prepare_goldens(
         let (film, cached, cache_note) = match read_cached(&path, &source.case) {
             Some(film) => (film, true, None),
             None => {
-                let film = render_case(&source.case, show_progress).map_err(|source_error| GradeError::Golden {
+                let film = {
+                    progress.step(&format!("rendering golden {}", source.name));
+                    render_case_reporting(&source.case, progress)
+                }
+                .map_err(|source_error| GradeError::Golden {
                     location: source.location.clone(),
                     render: source.name.clone(),
                     source: Box::new(source_error),
@@ -122,7 +138,7 @@ pub fn prepare_goldens(
 fn read_cached(path: &Path, case: &Case) -> Option<Film> {
     let bytes = fs::read(path).ok()?;
     let film = decode_exr(&bytes).ok()?;
-    (film.width == case.render.width && film.height == case.render.height).then_some(film)
+    (film.width == case.render.trace.width && film.height == case.render.trace.height).then_some(film)
 }
 
 fn store(path: &Path, film: &Film) -> Result<(), String> {

@@ -10,10 +10,12 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::golden::GOLDEN_DIR;
+use super::outcome::Outcome;
 use super::report::{ClassReport, format_points};
-use super::score::{ImageResult, Outcome, StudentResult, percent};
+use super::score::{ImageResult, StudentResult, percent};
+use crate::atomic_write::write_file_atomic;
 use crate::compare::Metrics;
-use crate::film::{OutputError, write_file_atomic};
+use crate::film::OutputError;
 
 const STYLE: &str = r#"
 body{font:14px/1.4 system-ui,sans-serif;margin:1.5em;color:#222;background:#fafafa}
@@ -22,6 +24,10 @@ a{color:#1a5fb4}.muted{color:#666}
 table{border-collapse:collapse;background:#fff}
 th,td{border:1px solid #ccc;padding:.25em .5em;text-align:center}td a{color:inherit}
 th{background:#eee;font-weight:600;vertical-align:bottom}td.name{text-align:left}
+.scroll{overflow-x:auto;max-width:100%}
+#grades .name{position:sticky;left:0;z-index:1;background:#fff;box-shadow:1px 0 0 #ccc}
+#grades th.name{background:#eee}
+#grades td.lost{text-align:left;min-width:12em;max-width:24em;font-size:.9em}
 img.thumb{display:block;width:48px;height:48px;margin:.2em auto 0;object-fit:contain}
 .v-pass{background:#c8e6c9}.v-partial{background:#ffe0a3}.v-fail{background:#f4b4b4}
 .v-missing,.v-wrong-size,.v-wrong-format,.v-too-large,.v-unreadable{background:#d7c8ee}
@@ -53,6 +59,14 @@ addEventListener('load', function () {
   }
   document.body.setAttribute('data-images-loaded', loaded);
   document.body.setAttribute('data-images-broken', broken);
+  // Whether each student's name and summary are on screen without scrolling (the class table).
+  var lost = document.querySelector('#grades td.lost');
+  if (lost) {
+    var inView = lost.getBoundingClientRect().right <= window.innerWidth;
+    document.body.setAttribute('data-summary-in-view', inView);
+    var scroll = document.querySelector('.scroll');
+    document.body.setAttribute('data-table-scrolls', scroll.scrollWidth > scroll.clientWidth);
+  }
 });
 "#;
 
@@ -105,7 +119,12 @@ fn index(report: &ClassReport) -> String {
         escape(&rubric.path.display().to_string()),
         report.goldray,
     );
-    body.push_str("<table id=\"grades\">\n<thead><tr><th>Student</th><th>Total</th>");
+    // The student column stays put while the per-image cells scroll; the summary before them
+    // names the images that lost points, so a wide rubric never hides a failure off screen.
+    body.push_str(
+        "<div class=\"scroll\"><table id=\"grades\">\n<thead><tr><th class=\"name\">Student</th><th>Total</th>\
+         <th>Lost points on</th>",
+    );
     for image in &rubric.images {
         let file = escape(&image.file);
         let _ = write!(
@@ -117,10 +136,11 @@ fn index(report: &ClassReport) -> String {
     for student in &report.students {
         let _ = write!(
             body,
-            "<tr><td class=\"name\"><a href=\"{}\">{}</a></td><td>{} / {max}</td>",
+            "<tr><td class=\"name\"><a href=\"{}\">{}</a></td><td>{} / {max}</td><td class=\"lost\">{}</td>",
             escape(&student.page),
             escape(&student.name),
-            format_points(student.total)
+            format_points(student.total),
+            lost_points(student)
         );
         for result in &student.images {
             let _ = write!(
@@ -142,7 +162,7 @@ fn index(report: &ClassReport) -> String {
         let mean = |points: f64| format_points(points / count);
         let _ = write!(
             body,
-            "<tfoot><tr><th>Mean</th><th>{}</th>",
+            "<tfoot><tr><th class=\"name\">Mean</th><th>{}</th><th></th>",
             mean(report.students.iter().map(|s| s.total).sum())
         );
         for (column, _) in rubric.images.iter().enumerate() {
@@ -151,7 +171,7 @@ fn index(report: &ClassReport) -> String {
         }
         body.push_str("</tr></tfoot>\n");
     }
-    body.push_str("</table>\n");
+    body.push_str("</table></div>\n");
     if !report.ignored.is_empty() {
         let names: Vec<String> = report.ignored.iter().map(|n| escape(n)).collect();
         let _ = writeln!(
@@ -163,6 +183,50 @@ fn index(report: &ClassReport) -> String {
     body.push_str(LEGEND);
     page(&format!("Grades: {}", rubric.title), &body)
 }
+
+/// The images that did not get full points, most points lost first (rubric order among equals),
+/// each a link to its section of the student's page; past [`LOST_LISTED`] the rest are counted,
+/// so that one row never grows taller than a few lines.
+fn lost_points(student: &StudentResult) -> String {
+    let mut lost: Vec<&ImageResult> = student.images.iter().filter(|r| r.points < r.max_points).collect();
+    lost.sort_by(|a, b| earned(a).total_cmp(&earned(b)));
+    let mut links: Vec<String> = lost
+        .iter()
+        .take(LOST_LISTED)
+        .map(|r| {
+            let file = escape(&r.file);
+            format!(
+                "<a class=\"{}\" href=\"{}#{file}\">{file}</a>",
+                class_of(&r.outcome),
+                escape(&student.page)
+            )
+        })
+        .collect();
+    if lost.len() > LOST_LISTED {
+        links.push(format!(
+            "<a href=\"{}\">{} more</a>",
+            escape(&student.page),
+            lost.len() - LOST_LISTED
+        ));
+    }
+    if lost.is_empty() {
+        "none".to_owned()
+    } else {
+        format!("{}: {}", lost.len(), links.join(", "))
+    }
+}
+
+/// The share of an image's points a student earned (1 for an image worth nothing).
+fn earned(result: &ImageResult) -> f64 {
+    if result.max_points > 0.0 {
+        result.points / result.max_points
+    } else {
+        1.0
+    }
+}
+
+/// How many images the class table names per student before counting the rest.
+const LOST_LISTED: usize = 6;
 
 const LEGEND: &str = "<p class=\"muted\">\
 <span class=\"badge v-pass\">pass</span> full points · \
@@ -197,13 +261,6 @@ fn student_page(report: &ClassReport, student: &StudentResult) -> String {
     body.push_str("</nav>\n");
     // Lost points first, the largest share lost first; rubric order among equals.
     let mut order: Vec<&ImageResult> = student.images.iter().collect();
-    let earned = |r: &ImageResult| {
-        if r.max_points > 0.0 {
-            r.points / r.max_points
-        } else {
-            1.0
-        }
-    };
     order.sort_by(|a, b| earned(a).total_cmp(&earned(b)));
     for result in order {
         image_section(&mut body, result);

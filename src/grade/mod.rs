@@ -10,8 +10,9 @@
 //! ```no_run
 //! use goldray::grade::{GradeOptions, grade_class};
 //! # fn main() -> Result<(), goldray::grade::GradeError> {
-//! let options = GradeOptions { out: "report".into(), cache: None, show_progress: false };
-//! let report = grade_class("rubrics/mit6837.toml".as_ref(), "submissions".as_ref(), &options)?;
+//! use goldray::progress::Silent;
+//! let options = GradeOptions { out: "report".into(), cache: None };
+//! let report = grade_class("rubrics/mit6837.toml".as_ref(), "submissions".as_ref(), &options, &Silent)?;
 //! for student in &report.students {
 //!     println!("{}: {} / {}", student.name, student.total, student.max_points);
 //! }
@@ -22,6 +23,7 @@
 mod error;
 mod golden;
 mod html;
+mod outcome;
 mod report;
 mod rubric;
 mod score;
@@ -29,79 +31,42 @@ mod submission;
 
 use std::collections::BTreeMap;
 use std::fs;
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
 
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use rayon::prelude::*;
 
-pub use error::GradeError;
-pub use golden::{GoldenRender, Goldens, prepare_goldens};
+use crate::progress::Progress;
+pub use error::{GradeError, RubricError};
+pub use golden::{GoldenRender, Goldens, default_cache_dir, prepare_goldens};
+pub use outcome::Outcome;
 pub use report::{ClassReport, RubricSummary};
 pub use rubric::{ImageSpec, Output, RenderSource, Rubric, Rule, load_rubric, parse_rubric};
-pub use score::{ImageResult, Outcome, StudentResult, Submission, grade_image, judge};
+pub use score::{ImageResult, StudentResult, Submission, grade_image, judge};
 
-/// `goldray grade`'s command line.
-#[derive(Clone, Debug, clap::Args)]
-pub struct GradeArgs {
-    /// The rubric (TOML): expected files, their golden renders, limits and points.
-    #[arg(long)]
-    pub rubric: PathBuf,
-    /// A folder holding one folder per student.
-    pub submissions: PathBuf,
-    /// Where to write grades.csv, grades.json and index.html (with the pictures).
-    #[arg(long, default_value = "grade-report")]
-    pub out: PathBuf,
-    /// Worker threads (default: one per core).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
-    pub jobs: Option<u32>,
-    /// Golden image cache (default: OUT/cache); share one between reports to render once.
-    #[arg(long)]
-    pub cache: Option<PathBuf>,
-    /// No progress bar and no summary.
-    #[arg(long)]
-    pub quiet: bool,
-}
-
-/// Where the report goes and how grading talks to the terminal.
+/// Where the report and the golden cache go.
 #[derive(Clone, Debug)]
 pub struct GradeOptions {
     pub out: PathBuf,
-    /// `None`: `out/cache`.
+    /// `None`: [`default_cache_dir`].
     pub cache: Option<PathBuf>,
-    /// Progress bars on standard error (they stay hidden when it is not a terminal).
-    pub show_progress: bool,
-}
-
-/// Runs `goldray grade` and prints its summary. Returns an error only when grading could not run;
-/// what students handed in never makes it fail.
-pub fn run_grade(args: &GradeArgs) -> Result<ClassReport, GradeError> {
-    let mut pool = rayon::ThreadPoolBuilder::new();
-    if let Some(jobs) = args.jobs {
-        pool = pool.num_threads(jobs as usize);
-    }
-    let options = GradeOptions {
-        out: args.out.clone(),
-        cache: args.cache.clone(),
-        show_progress: !args.quiet,
-    };
-    let report = pool
-        .build()?
-        .install(|| grade_class(&args.rubric, &args.submissions, &options))?;
-    if !args.quiet {
-        println!("{}", summary(&report, &args.out));
-    }
-    Ok(report)
 }
 
 /// Loads the rubric, prepares the goldens, grades every student folder of `submissions` on the
-/// current rayon pool and writes the whole report.
-pub fn grade_class(rubric_path: &Path, submissions: &Path, options: &GradeOptions) -> Result<ClassReport, GradeError> {
+/// current rayon pool and writes the whole report. Golden renders, then graded students, are
+/// reported to `progress`. Returns an error only when grading could not run; what students
+/// handed in never makes it fail.
+pub fn grade_class(
+    rubric_path: &Path,
+    submissions: &Path,
+    options: &GradeOptions,
+    progress: &dyn Progress,
+) -> Result<ClassReport, GradeError> {
     let rubric = load_rubric(rubric_path)?;
     let out = &options.out;
-    let cache = options.cache.clone().unwrap_or_else(|| out.join("cache"));
+    let cache = options.cache.clone().unwrap_or_else(default_cache_dir);
     let (folders, ignored) = student_folders(submissions, &[out, &cache])?;
-    let goldens = prepare_goldens(&rubric, &cache, out, options.show_progress)?;
+    let goldens = prepare_goldens(&rubric, &cache, out, progress)?;
 
     let names: Vec<String> = folders.keys().cloned().collect();
     let folders: Vec<Submission> = folders
@@ -114,17 +79,22 @@ pub fn grade_class(rubric_path: &Path, submissions: &Path, options: &GradeOption
     // One task per image rather than per student, so that both cores stay busy to the end of a
     // small class.
     let per_student = rubric.images.len();
-    let bar = progress_bar((folders.len() * per_student) as u64, options.show_progress);
+    progress.begin("grading", (folders.len() * per_student) as u64);
+    // Images left per student, so that the last one to finish can say the student is done.
+    let left: Vec<AtomicUsize> = folders.iter().map(|_| AtomicUsize::new(per_student)).collect();
     let results = (0..folders.len() * per_student)
         .into_par_iter()
         .map(|task| {
             let (student, image) = (task / per_student, task % per_student);
             let result = grade_image(&rubric.images[image], &goldens.images[image], &folders[student], out);
-            bar.inc(1);
+            progress.advance(1);
+            if left[student].fetch_sub(1, Ordering::Relaxed) == 1 {
+                progress.done(&folders[student].name);
+            }
             result
         })
         .collect::<Result<Vec<_>, _>>()?;
-    bar.finish_and_clear();
+    progress.finish();
     let mut results = results.into_iter();
     let students = folders
         .iter()
@@ -135,6 +105,7 @@ pub fn grade_class(rubric_path: &Path, submissions: &Path, options: &GradeOption
         goldray: env!("CARGO_PKG_VERSION"),
         rubric: RubricSummary::of(&rubric),
         submissions: submissions.to_path_buf(),
+        cache: cache.clone(),
         goldens: goldens.renders,
         ignored,
         students,
@@ -175,21 +146,8 @@ fn student_folders(
     Ok((folders, ignored))
 }
 
-fn progress_bar(total: u64, show: bool) -> ProgressBar {
-    let target = if show && std::io::stderr().is_terminal() {
-        ProgressDrawTarget::stderr()
-    } else {
-        ProgressDrawTarget::hidden()
-    };
-    let bar = ProgressBar::with_draw_target(Some(total), target);
-    if let Ok(style) = ProgressStyle::with_template("grading [{bar:40}] {pos}/{len} images {elapsed} (eta {eta})") {
-        bar.set_style(style.progress_chars("=> "));
-    }
-    bar
-}
-
 /// What the TA reads on the terminal: how many of each verdict, and where the report is.
-fn summary(report: &ClassReport, out: &Path) -> String {
+pub fn summary(report: &ClassReport, out: &Path) -> String {
     let mut counts: BTreeMap<&str, usize> = BTreeMap::new();
     for result in report.students.iter().flat_map(|s| &s.images) {
         *counts.entry(result.outcome.word()).or_default() += 1;
@@ -197,7 +155,7 @@ fn summary(report: &ClassReport, out: &Path) -> String {
     let counts: Vec<String> = counts.iter().map(|(word, n)| format!("{n} {word}")).collect();
     let rendered = report.goldens.iter().filter(|g| !g.cached).count();
     format!(
-        "graded {} students on {} images ({}); {} golden renders ({rendered} rendered, {} cached)\nreport: {}",
+        "graded {} students on {} images ({}); {} golden renders ({rendered} rendered, {} cached in {})\nreport: {}",
         report.students.len(),
         report.rubric.images.len(),
         if counts.is_empty() {
@@ -207,6 +165,7 @@ fn summary(report: &ClassReport, out: &Path) -> String {
         },
         report.goldens.len(),
         report.goldens.len() - rendered,
+        report.cache.display(),
         out.join("index.html").display()
     )
 }

@@ -9,7 +9,8 @@ use serde::Serialize;
 use super::golden::GoldenRender;
 use super::rubric::{ImageSpec, Rubric};
 use super::score::StudentResult;
-use crate::film::{OutputError, write_file_atomic};
+use crate::atomic_write::write_file_atomic;
+use crate::film::OutputError;
 
 /// Everything one grading run found; `grades.json` is this, serialised.
 #[derive(Clone, Debug, Serialize)]
@@ -18,6 +19,8 @@ pub struct ClassReport {
     pub goldray: &'static str,
     pub rubric: RubricSummary,
     pub submissions: PathBuf,
+    /// Where the golden renders were cached.
+    pub cache: PathBuf,
     pub goldens: Vec<GoldenRender>,
     /// Entries of the submissions folder that are not student folders (loose files), by name.
     pub ignored: Vec<String>,
@@ -50,7 +53,8 @@ pub fn write_data(report: &ClassReport, out: &Path) -> Result<(), OutputError> {
     // Serialising plain data to a string cannot fail; infinite numbers (the PSNR of identical
     // pictures) become null.
     let json = serde_json::to_string_pretty(report).unwrap_or_else(|e| format!("{{\"error\": {:?}}}", e.to_string()));
-    write_file_atomic(&out.join("grades.json"), (json + "\n").as_bytes())
+    write_file_atomic(&out.join("grades.json"), (json + "\n").as_bytes())?;
+    Ok(())
 }
 
 /// One row per student: the folder name, the points of each image in rubric order, the total.

@@ -6,14 +6,13 @@
 
 use std::path::{Path, PathBuf};
 
-use serde::{Deserialize, Serialize};
-use toml::de::DeTable;
+use serde::Serialize;
 
-use super::error::GradeError;
-use crate::case::{
-    self, AssignmentOptions, Case, CaseError, Doc, Field, LoadOptions, MAX_BOUNCES, MAX_IMAGE_SIZE, SourceLocation,
-    Table, load_assignment_scene,
-};
+use super::error::RubricError;
+use crate::case::{self, AssignmentOptions, Case, LoadOptions, MAX_BOUNCES, load_assignment_scene};
+use crate::image_size::{MAX_IMAGE_SIZE, SizeLimit, check_side};
+use crate::located_toml::{self, Doc, Field, SourceLocation, Table, suggest};
+use crate::named_enum::named_enum;
 
 /// A whole rubric, every path resolved and every render source loaded.
 #[derive(Clone, Debug)]
@@ -49,13 +48,13 @@ pub enum Output {
     },
 }
 
-/// What `output = "…"` may say.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
-#[serde(rename_all = "lowercase")]
-enum OutputKind {
-    Color,
-    Normals,
-    Depth,
+named_enum! {
+    /// What `output = "…"` may say.
+    enum OutputKind: "output" {
+        Color = "color",
+        Normals = "normals",
+        Depth = "depth",
+    }
 }
 
 /// One `[image."FILE"]`: an expected file of every submission.
@@ -111,10 +110,10 @@ const RENDER_KEYS: &[&str] = &["case", "scene", "size", "bounces", "shadows", "j
 /// Flags of the course binary: a TOML case sets these in its own `[render]`.
 const SCENE_ONLY_KEYS: &[&str] = &["bounces", "shadows", "jitter", "filter"];
 
-type Result<T> = std::result::Result<T, GradeError>;
+type Result<T> = std::result::Result<T, RubricError>;
 
 pub fn load_rubric(path: &Path) -> Result<Rubric> {
-    let source = std::fs::read_to_string(path).map_err(|source| GradeError::ReadRubric {
+    let source = std::fs::read_to_string(path).map_err(|source| RubricError::Read {
         path: path.to_path_buf(),
         source,
     })?;
@@ -123,22 +122,17 @@ pub fn load_rubric(path: &Path) -> Result<Rubric> {
 
 /// `path` names the rubric in messages; its directory anchors the relative paths inside.
 pub fn parse_rubric(source: &str, path: &Path) -> Result<Rubric> {
-    let root = DeTable::parse(source).map_err(|e| CaseError::Syntax {
-        location: SourceLocation::from_offset(path, source, e.span().map_or(0, |s| s.start)),
-        message: e.message().to_owned(),
-    })?;
+    let root = located_toml::parse(source, path)?;
     // Absolute, so that golden cache keys do not depend on the working directory.
     let dir = match path.parent() {
         Some(parent) if !parent.as_os_str().is_empty() => parent.to_path_buf(),
         _ => PathBuf::from("."),
     };
     let dir = dir.canonicalize().unwrap_or(dir);
-    let options = LoadOptions::default();
     let doc = Doc {
         file: path,
         text: source,
         dir: &dir,
-        options: &options,
     };
     let top = Table::new(&doc, "the rubric".to_owned(), root.span(), root.get_ref());
     top.check_keys(TOP_KEYS)?;
@@ -165,11 +159,10 @@ pub fn parse_rubric(source: &str, path: &Path) -> Result<Rubric> {
         }
     }
     if images.is_empty() {
-        return Err(CaseError::Missing {
+        return Err(RubricError::Missing {
             file: path.to_path_buf(),
             message: "the rubric lists no images: add [image.\"FILE.png\"] tables".to_owned(),
-        }
-        .into());
+        });
     }
     Ok(Rubric {
         path: path.to_path_buf(),
@@ -190,7 +183,7 @@ fn render_source(entry: &Field) -> Result<RenderSource> {
     let location = doc.location(entry.key_span.start);
     let size = table.read("size", None, |f| {
         let [w, h] = f.numbers::<2>("an array [width, height]")?;
-        let side = |v: f64| v.fract() == 0.0 && (1.0..=MAX_IMAGE_SIZE as f64).contains(&v);
+        let side = |v: f64| v.fract() == 0.0 && check_side(v as i64, SizeLimit::Fixed).is_ok();
         if side(w) && side(h) {
             Ok(Some((w as u32, h as u32)))
         } else {
@@ -213,8 +206,8 @@ fn render_source(entry: &Field) -> Result<RenderSource> {
             let path = doc.dir.join(case_field.string()?);
             case::load(&path, &LoadOptions::default()).map(|mut case| {
                 if let Some((width, height)) = size {
-                    case.render.width = width;
-                    case.render.height = height;
+                    case.render.trace.width = width;
+                    case.render.trace.height = height;
                 }
                 case
             })
@@ -250,7 +243,7 @@ fn render_source(entry: &Field) -> Result<RenderSource> {
                 .into());
         }
     };
-    let case = loaded.map_err(|source| GradeError::Source {
+    let case = loaded.map_err(|source| RubricError::Source {
         location: location.clone(),
         render: name.clone(),
         source: Box::new(source),
@@ -275,7 +268,7 @@ fn image_spec(entry: &Field, renders: &[RenderSource], base: &Rule, base_points:
     let render = render_field.string()?;
     let Some(render_index) = renders.iter().position(|r| r.name == render) else {
         let names: Vec<&str> = renders.iter().map(|r| r.name.as_str()).collect();
-        let tail = case::suggest(render, &names, "renders");
+        let tail = suggest(render, &names, "renders");
         return Err(render_field
             .error(format!("no [render.{render}] in the rubric{tail}"))
             .into());

@@ -6,49 +6,12 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use super::golden::GOLDEN_DIR;
+use super::outcome::Outcome;
 use super::rubric::{ImageSpec, Rule};
 use super::submission::{Folder, read_png};
-use crate::case::Tolerance;
-use crate::compare::{Image, Metrics, compare, diff_heatmap};
-use crate::film::{OutputError, encode_png, write_file_atomic, write_png};
-
-/// The verdict on one expected file. Only the first three come from a comparison; the others say
-/// why there was nothing to compare, and score nothing.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-#[serde(tag = "verdict", rename_all = "snake_case")]
-pub enum Outcome {
-    /// Within the rule's pass limits: full points.
-    Pass,
-    /// Within the partial limits only: `partial_credit × points`.
-    Partial,
-    /// Beyond the partial limits: no points.
-    Fail,
-    /// No such file in the student's folder.
-    Missing,
-    /// A readable PNG of another size than the golden image.
-    WrongSize { expected: [u32; 2], actual: [u32; 2] },
-    /// Not a PNG: an EXR, a JPEG, a text file…
-    WrongFormat { found: String },
-    /// Refused before decoding: a huge file, or a PNG declaring a huge picture.
-    TooLarge { reason: String },
-    /// A PNG that cannot be decoded (truncated, corrupt), or a file that cannot be read.
-    Unreadable { reason: String },
-}
-
-impl Outcome {
-    pub fn word(&self) -> &'static str {
-        match self {
-            Outcome::Pass => "pass",
-            Outcome::Partial => "partial",
-            Outcome::Fail => "fail",
-            Outcome::Missing => "missing",
-            Outcome::WrongSize { .. } => "wrong size",
-            Outcome::WrongFormat { .. } => "wrong format",
-            Outcome::TooLarge { .. } => "too large",
-            Outcome::Unreadable { .. } => "unreadable",
-        }
-    }
-}
+use crate::atomic_write::write_file_atomic;
+use crate::compare::{Image, Metrics, Tolerance, compare, diff_heatmap};
+use crate::film::{OutputError, encode_png, write_png};
 
 /// One expected file of one student.
 #[derive(Clone, Debug, Serialize)]

@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 use image::codecs::png::PngDecoder;
 use image::{ColorType, DynamicImage, ImageDecoder, ImageError, Limits, RgbImage};
 
-use super::score::Outcome;
+use super::outcome::Outcome;
 
 /// The largest file read at all: a 16-bit RGBA PNG of a 4096² image stored uncompressed is
 /// 128 MiB, far beyond any honest submission.

@@ -1,10 +1,7 @@
-//! Turning a scene into a film: camera, lights, materials, sampling, the Whitted integrator and
-//! the supersampling filter.
+//! Turning a scene into a film: sampling, the Whitted integrator and the supersampling filter.
+//! What is drawn (camera, lights, materials) belongs to the scene; this module only reads it.
 
-pub mod camera;
 pub mod integrator;
-pub mod light;
-pub mod material;
 pub mod renderer;
 pub mod sampler;
 

@@ -21,12 +21,12 @@ const GAUSSIAN_WEIGHTS: [Real; 3] = [0.25, 0.5, 0.25];
 
 
 /// Renders the scene without counting anything.
-pub fn render(scene: &Scene, options: &RenderOptions, progress: &Progress) -> Film {
+pub fn render(scene: &Scene, options: &RenderOptions, progress: &dyn Progress) -> Film {
     render_counted::<NoCount>(scene, options, progress).0
 }
 
 /// [`render`], also counting every ray traced, by kind (for `--stats`). The film is the same.
-pub fn render_counting_rays(scene: &Scene, options: &RenderOptions, progress: &Progress) -> (Film, RayCounts) {
+pub fn render_counting_rays(scene: &Scene, options: &RenderOptions, progress: &dyn Progress) -> (Film, RayCounts) {
     render_counted::<RayCounts>(scene, options, progress)
 }
 
@@ -37,15 +37,15 @@ pub fn render_counting_rays(scene: &Scene, options: &RenderOptions, progress: &P
 /// Private, so that its only two copies are those above, compiled in this crate: a copy
 /// instantiated in another crate (a benchmark, say) would be optimised differently from the one
 /// the command line runs.
-fn render_counted<C: RayCounter>(scene: &Scene, options: &RenderOptions, progress: &Progress) -> (Film, C) {
-    let mut film = Film::new(options.width, options.height);
+fn render_counted<C: RayCounter>(scene: &Scene, options: &RenderOptions, progress: &dyn Progress) -> (Film, C) {
+    let mut film = Film::new(options.trace.width, options.trace.height);
     let pixels = PixelRenderer {
         scene,
-        integrator: Whitted::new(scene, options.bounces, options.shadows, options.spawn),
-        sampler: Sampler::new(options.samples, options.seed),
+        integrator: Whitted::new(scene, options.trace.bounces, options.trace.shadows, options.spawn),
+        sampler: Sampler::new(options.trace.samples, options.trace.seed),
         options,
     };
-    let width = options.width as usize;
+    let width = options.trace.width as usize;
     let band = width * BAND_ROWS;
     let counter = film.color
         .par_chunks_mut(band)
@@ -68,7 +68,6 @@ fn render_counted<C: RayCounter>(scene: &Scene, options: &RenderOptions, progres
             counter
         })
         .reduce(C::default, C::merge);
-    progress.finish();
     (film, counter)
 }
 
@@ -88,9 +87,9 @@ struct PixelRenderer<'a> {
 impl PixelRenderer<'_> {
     /// The pixel's colour and AOVs; every ray traced for it is added to `rays`.
     fn pixel(&self, x: u32, y: u32, rays: &mut RayCounts) -> Pixel {
-        let (width, height) = (self.options.width, self.options.height);
+        let (width, height) = (self.options.trace.width, self.options.trace.height);
         let centre = Vec2::new(x as Real + 0.5, y as Real + 0.5);
-        match self.options.filter {
+        match self.options.trace.filter {
             Filter::None if self.sampler.samples_per_pixel() == 1 => {
                 rays.camera += 1;
                 let (color, first) = self.integrator.trace(self.scene.camera.ray(centre, width, height), rays);
@@ -132,7 +131,7 @@ impl PixelRenderer<'_> {
             return None;
         }
         rays.aov += 1;
-        let ray = self.scene.camera.ray(centre, self.options.width, self.options.height);
+        let ray = self.scene.camera.ray(centre, self.options.trace.width, self.options.trace.height);
         self.scene.geometry.intersect(&ray)
     }
 }

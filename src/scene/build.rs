@@ -4,23 +4,24 @@
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use glam::{DMat4, DVec3};
 
+use super::geometry::bvh::Bvh;
 use super::geometry::mesh::{Mesh, NormalSource};
 use super::geometry::plane::Plane;
 use super::geometry::sphere::Sphere;
 use super::geometry::transform::Transform;
 use super::real::{Vec3, mat4, real, vec3};
-use super::render::camera::Camera;
-use super::render::light::Light;
-use super::render::material::Material;
+use super::camera::Camera;
+use super::light::Light;
+use super::material::Material;
 use super::{Aggregate, Background, CubeMap, Object, Scene, Shape, Triangle};
 use crate::build_error::{BuildError, MeshError, TransformError};
 use crate::case::{Case, LightSpec, ObjectSpec, ShapeSpec, composite_matrix};
 use crate::options::Profile;
-use crate::stats::{BuildStats, MeshStats};
+use crate::stats::{BuildStats, BvhStats, MeshStats};
 
 pub fn build_scene(case: &Case) -> Result<Scene, BuildError> {
     build_scene_measured(case).map(|(scene, _)| scene)
@@ -79,7 +80,7 @@ pub fn build_scene_measured(case: &Case) -> Result<(Scene, BuildStats), BuildErr
     }
     let bvh_start = Instant::now();
     let geometry = Aggregate::new(builder.objects, builder.planes);
-    let scene_bvh = geometry.bvh().map(|bvh| bvh.stats(bvh_start.elapsed()));
+    let scene_bvh = geometry.bvh().map(|bvh| bvh_stats(bvh, bvh_start.elapsed()));
     let scene = Scene {
         camera,
         background,
@@ -89,6 +90,12 @@ pub fn build_scene_measured(case: &Case) -> Result<(Scene, BuildStats), BuildErr
         geometry,
     };
     Ok((scene, BuildStats { cube_map_load_time, meshes: builder.mesh_stats, scene_bvh }))
+}
+
+/// A BVH's shape for `--stats`. Assembled here, above both, so that the geometry does not know the
+/// statistics exist.
+fn bvh_stats(bvh: &Bvh, build_time: Duration) -> BvhStats {
+    BvhStats { build_time, primitives: bvh.primitive_count(), nodes: bvh.node_count(), leaves: bvh.leaf_count() }
 }
 
 fn light(spec: &LightSpec, eye: DVec3) -> Light {
@@ -194,7 +201,7 @@ impl Builder {
             path: path.to_path_buf(),
             triangles: mesh.triangle_count(),
             load_time: start.elapsed().saturating_sub(bvh_build_time),
-            bvh: mesh.bvh().stats(bvh_build_time),
+            bvh: bvh_stats(mesh.bvh(), bvh_build_time),
         });
         self.meshes.insert(path.to_path_buf(), mesh.clone());
         Ok(mesh)

@@ -1,5 +1,5 @@
 //! The assignment's cube-map background, sampled exactly as its reference renderer does
-//! (DESIGN.md, "The assignment profile"): texel row 0 is the PNG's top row, faces chosen by the
+//! (docs/ARCHITECTURE.md, "Cube maps"): texel row 0 is the PNG's top row, faces chosen by the
 //! largest component, bilinear weights with edge-clamped indices.
 
 use std::path::Path;

@@ -1,8 +1,12 @@
-//! A scene ready to render: built once from a case, immutable while rendering.
+//! A scene ready to render: built once from a case, immutable while rendering. Camera, lights and
+//! materials are part of the description (peers of the geometry, as in pbrt-v4).
 
 mod aggregate;
 mod build;
+pub mod camera;
 mod cube_map;
+pub mod light;
+pub mod material;
 mod object;
 
 pub use aggregate::{Aggregate, Intersection};
@@ -10,10 +14,10 @@ pub use build::{build_scene, build_scene_measured};
 pub use cube_map::CubeMap;
 pub use object::{Object, Shape, ShapeHit, Triangle};
 
-use super::{geometry, real, render};
-use render::camera::Camera;
-use render::light::Light;
-use render::material::Material;
+use super::{geometry, real};
+use camera::Camera;
+use light::Light;
+use material::Material;
 use real::{Color, Vec3};
 
 /// What a ray that hits nothing sees.

@@ -17,8 +17,7 @@ use std::time::Duration;
 
 use serde::{Serialize, Serializer};
 
-use crate::case::Case;
-use crate::film::{OutputError, write_file_atomic};
+use crate::atomic_write::{AtomicWriteError, write_file_atomic};
 
 /// Why `--stats-json` could not be written.
 #[derive(Debug, thiserror::Error)]
@@ -27,7 +26,7 @@ pub enum StatsError {
     Json(#[from] serde_json::Error),
     /// The path is named because the underlying error may only name a directory on the way.
     #[error("statistics {}: {source}", path.display())]
-    Write { path: PathBuf, source: OutputError },
+    Write { path: PathBuf, source: AtomicWriteError },
 }
 
 /// A BVH's size and what building it took.
@@ -134,13 +133,21 @@ pub struct RenderStats {
 }
 
 impl RenderStats {
+    /// `case` names what was rendered (a case's file stem) and `(width, height)` is its image size.
     /// Call once the render is written: the peak memory is read now.
-    pub fn new(case: &Case, phases: Phases, build: BuildStats, rays: &RayCounts, threads: usize) -> RenderStats {
+    pub fn new(
+        case: &str,
+        (width, height): (u32, u32),
+        phases: Phases,
+        build: BuildStats,
+        rays: &RayCounts,
+        threads: usize,
+    ) -> RenderStats {
         let seconds = phases.render.as_secs_f64();
         RenderStats {
-            case: case.name.clone(),
-            width: case.render.width,
-            height: case.render.height,
+            case: case.to_owned(),
+            width,
+            height,
             threads,
             seconds: phases,
             build,
@@ -203,12 +210,6 @@ mod tests {
 
     #[test]
     fn rates_are_millions_of_rays_per_second_of_render_time() {
-        let case = crate::case::parse(
-            "[camera]\ncenter = [0, 0, 10]\ndirection = [0, 0, -1]\nup = [0, 1, 0]\nfov = 30\n",
-            Path::new("tiny.toml"),
-            &crate::case::LoadOptions::default(),
-        )
-        .unwrap();
         let rays = RayCounts {
             camera: 3_000_000,
             aov: 0,
@@ -219,7 +220,7 @@ mod tests {
             render: Duration::from_secs(2),
             ..Phases::default()
         };
-        let stats = RenderStats::new(&case, phases, BuildStats::default(), &rays, 2);
+        let stats = RenderStats::new("tiny", (200, 200), phases, BuildStats::default(), &rays, 2);
         assert_eq!(
             (stats.case.as_str(), stats.width, stats.height, stats.threads),
             ("tiny", 200, 200, 2)
@@ -228,7 +229,7 @@ mod tests {
         assert_eq!(stats.mrays_per_second.shadow, 0.5);
         assert_eq!(stats.mrays_per_second.total, 2.0);
         assert_eq!(stats.rays.rows()[4], ("total", 4_000_000));
-        let instant = RenderStats::new(&case, Phases::default(), BuildStats::default(), &rays, 1);
+        let instant = RenderStats::new("tiny", (200, 200), Phases::default(), BuildStats::default(), &rays, 1);
         assert_eq!(instant.mrays_per_second.total, 0.0, "no division by a zero render time");
     }
 }

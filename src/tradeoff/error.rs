@@ -5,9 +5,9 @@
 use std::io;
 use std::path::PathBuf;
 
+use crate::atomic_write::AtomicWriteError;
 use crate::build_error::BuildError;
 use crate::case::CaseError;
-use crate::film::OutputError;
 
 #[derive(Debug, thiserror::Error)]
 pub enum TradeoffError {
@@ -42,7 +42,7 @@ pub enum TradeoffError {
     Plot(String),
 
     #[error("cannot write the report: {0}")]
-    Write(#[from] OutputError),
+    Write(#[from] AtomicWriteError),
 
     #[error("cannot start worker threads: {0}")]
     Threads(#[from] rayon::ThreadPoolBuildError),

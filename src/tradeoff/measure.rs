@@ -6,14 +6,15 @@ use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use super::error::TradeoffError;
-use super::sweep::Setting;
-use crate::case::{Case, Tolerance};
-use crate::compare::{Image, compare};
+use super::setting::Setting;
+use crate::case::Case;
+use crate::compare::{Image, Tolerance, compare};
 use crate::film::Film;
+use crate::named_enum::named_enum;
 use crate::options::{Filter, Precision, RenderOptions};
 use crate::pipeline::render_options;
 use crate::precision::{double, single};
-use crate::progress::Progress;
+use crate::progress::Silent;
 use crate::stats::RayCounts;
 
 /// A cheap setting is rendered again until its runs add up to the plan's `min_time`, but never
@@ -68,13 +69,13 @@ impl<'a> Renderer<'a> {
     /// One render of the film `options` describe, in `precision`, with its rays.
     fn render_once(&self, precision: Precision, options: &RenderOptions) -> (Film, RayCounts) {
         match precision {
-            Precision::F32 => single::render::render_counting_rays(&self.single, options, &Progress::hidden()),
-            Precision::F64 => double::render::render_counting_rays(&self.double, options, &Progress::hidden()),
+            Precision::F32 => single::render::render_counting_rays(&self.single, options, &Silent),
+            Precision::F64 => double::render::render_counting_rays(&self.double, options, &Silent),
         }
     }
 
     pub fn pixels(&self) -> u64 {
-        u64::from(self.case.render.width) * u64::from(self.case.render.height)
+        u64::from(self.case.render.trace.width) * u64::from(self.case.render.trace.height)
     }
 
     /// Renders `setting`, again and again until the runs add up to `min_time` (at most
@@ -112,7 +113,7 @@ impl<'a> Renderer<'a> {
     /// same seed a setting's samples would partly repeat the reference's and its error would look
     /// smaller than it is.
     pub fn reference(&self, samples: u32, bounces: u32) -> Reference {
-        let seed = self.case.render.seed.wrapping_add(1);
+        let seed = self.case.render.trace.seed.wrapping_add(1);
         let precision = REFERENCE_PRECISION;
         let mut case = Setting {
             samples,
@@ -121,7 +122,7 @@ impl<'a> Renderer<'a> {
             precision,
         }
         .apply(self.case);
-        case.render.seed = seed;
+        case.render.trace.seed = seed;
         let start = Instant::now();
         let (film, rays) = self.render_once(precision, &render_options(&case));
         Reference {
@@ -163,16 +164,18 @@ pub fn errors(reference: &Film, film: &Film, setting: &Setting) -> Result<Errors
     })
 }
 
-/// Which error the plot and the Pareto front rank settings by.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, clap::ValueEnum)]
-pub enum Metric {
-    /// RMSE on linear colour: its log-log slope against samples is the convergence rate
-    #[default]
-    Rmse,
-    /// The largest error of any colour channel of any pixel
-    Max,
-    /// The FLIP mean: what a viewer would notice
-    Flip,
+named_enum! {
+    /// Which error the plot and the Pareto front rank settings by; named as `--metric` names it.
+    #[derive(Default)]
+    pub enum Metric: "metric" {
+        /// RMSE on linear colour: its log-log slope against samples is the convergence rate
+        #[default]
+        Rmse = "rmse",
+        /// The largest error of any colour channel of any pixel
+        Max = "max",
+        /// The FLIP mean: what a viewer would notice
+        Flip = "flip",
+    }
 }
 
 impl Metric {
@@ -184,8 +187,8 @@ impl Metric {
         }
     }
 
-    /// The column name in the report and the flag's value.
-    pub fn name(self) -> &'static str {
+    /// The error's column in the report (`max_error` where the flag says `max`).
+    pub fn column(self) -> &'static str {
         match self {
             Metric::Rmse => "rmse",
             Metric::Max => "max_error",

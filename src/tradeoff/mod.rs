@@ -16,34 +16,32 @@
 //!     target_flip: Some(0.05),
 //!     ..TradeoffOptions::new("tradeoff/jitter")
 //! };
-//! let (tradeoff, written) = run_tradeoff("cases/jitter.toml".as_ref(), &options)?;
+//! let (tradeoff, written) = run_tradeoff("cases/jitter.toml".as_ref(), &options, &goldray::progress::Silent)?;
 //! println!("{}", tradeoff.target_sentence().unwrap_or_default());
 //! # Ok(())
 //! # }
 //! ```
 
-mod cli;
 mod error;
 mod measure;
 mod pareto;
 mod plot;
 mod report;
+mod setting;
 mod sweep;
 
-use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-
-pub use cli::{TradeoffArgs, run_tradeoff_command};
 pub use error::TradeoffError;
 pub use measure::{Errors, Measurement, Metric, Reference};
 pub use pareto::{cheapest_within, pareto_front};
 pub use plot::{HEIGHT as PLOT_HEIGHT, WIDTH as PLOT_WIDTH};
-pub use report::{CSV_COLUMNS, CSV_FILE, MARKDOWN_FILE, PLOT_FILE, csv, markdown};
-pub use sweep::{BounceOutcome, Setting, SweepPlan};
+pub use report::{CSV_COLUMNS, CSV_FILE, MARKDOWN_FILE, PLOT_FILE, csv, markdown, summary};
+pub use setting::Setting;
+pub use sweep::{BounceOutcome, DEFAULT_FILTERS, SweepPlan};
 
 use crate::case::{self, Case, LoadOptions};
+use crate::progress::Progress;
 use report::{check_replaceable, significant, write_report};
 use sweep::run_sweep;
 
@@ -58,12 +56,10 @@ pub struct TradeoffOptions {
     pub target_flip: Option<f64>,
     /// Replace report files in `out` even when goldray did not write them.
     pub force: bool,
-    /// A progress bar over the sweep on standard error, when it is a terminal.
-    pub show_progress: bool,
 }
 
 impl TradeoffOptions {
-    /// The full default sweep, reported into `out`, without a target or a progress bar.
+    /// The full default sweep, reported into `out`, without a target.
     pub fn new(out: impl Into<PathBuf>) -> TradeoffOptions {
         TradeoffOptions {
             out: out.into(),
@@ -71,7 +67,6 @@ impl TradeoffOptions {
             metric: Metric::default(),
             target_flip: None,
             force: false,
-            show_progress: false,
         }
     }
 }
@@ -151,28 +146,37 @@ impl Tradeoff {
 
 /// Loads the case, checks that the report may be written, sweeps, and writes `tradeoff.csv`,
 /// `tradeoff.md` and `tradeoff.png` into `options.out`, returning what it found and the paths
-/// written. On any error nothing is written. Renders on the current rayon pool.
-pub fn run_tradeoff(case_path: &Path, options: &TradeoffOptions) -> Result<(Tradeoff, Vec<PathBuf>), TradeoffError> {
+/// written. On any error nothing is written. Renders on the current rayon pool, reporting each
+/// setting to `progress`.
+pub fn run_tradeoff(
+    case_path: &Path,
+    options: &TradeoffOptions,
+    progress: &dyn Progress,
+) -> Result<(Tradeoff, Vec<PathBuf>), TradeoffError> {
     options.plan.validate()?;
     let case = case::load(case_path, &LoadOptions::default())?;
     check_replaceable(&options.out, options.force)?;
-    let tradeoff = measure_tradeoff(&case, options)?;
+    let tradeoff = measure_tradeoff(&case, options, progress)?;
     let written = write_report(&tradeoff, &options.out)?;
     Ok((tradeoff, written))
 }
 
 /// The sweep and its analysis, without writing anything: what [`run_tradeoff`] reports.
-pub fn measure_tradeoff(case: &Case, options: &TradeoffOptions) -> Result<Tradeoff, TradeoffError> {
+pub fn measure_tradeoff(
+    case: &Case,
+    options: &TradeoffOptions,
+    progress: &dyn Progress,
+) -> Result<Tradeoff, TradeoffError> {
     let plan = &options.plan;
     plan.validate()?;
     let mut case = case.clone();
     if let Some((width, height)) = plan.size {
-        case.render.width = width;
-        case.render.height = height;
+        case.render.trace.width = width;
+        case.render.trace.height = height;
     }
-    let bar = progress_bar(options.show_progress);
-    let sweep = run_sweep(&case, plan, &bar)?;
-    bar.finish_and_clear();
+    let sweep = run_sweep(&case, plan, progress);
+    progress.finish();
+    let sweep = sweep?;
 
     let metric = options.metric;
     let points = |value: &dyn Fn(&Measurement) -> f64| -> Vec<(f64, f64)> {
@@ -190,8 +194,8 @@ pub fn measure_tradeoff(case: &Case, options: &TradeoffOptions) -> Result<Tradeo
     Ok(Tradeoff {
         case_name: case.name.clone(),
         case_path: case.path.clone(),
-        width: case.render.width,
-        height: case.render.height,
+        width: case.render.trace.width,
+        height: case.render.trace.height,
         base: Setting::of(&case),
         threads: rayon::current_num_threads(),
         min_time: plan.min_time,
@@ -202,17 +206,4 @@ pub fn measure_tradeoff(case: &Case, options: &TradeoffOptions) -> Result<Tradeo
         pareto,
         target,
     })
-}
-
-fn progress_bar(show: bool) -> ProgressBar {
-    let target = if show && std::io::stderr().is_terminal() {
-        ProgressDrawTarget::stderr()
-    } else {
-        ProgressDrawTarget::hidden()
-    };
-    let bar = ProgressBar::with_draw_target(Some(0), target);
-    if let Ok(style) = ProgressStyle::with_template("tradeoff [{bar:40}] {percent:>3}% {elapsed} (eta {eta}) {msg}") {
-        bar.set_style(style.progress_chars("=> "));
-    }
-    bar
 }

@@ -265,7 +265,7 @@ fn draw(t: &Tradeoff, pixels: &mut [u8]) -> Result<(), Box<dyn std::error::Error
         ))?
         .label(format!(
             "Pareto front by {}: nothing is both faster and better",
-            t.metric.name()
+            t.metric.column()
         ))
         .legend(move |(x, y)| Circle::new((x, y), 7, front_style));
     chart.draw_series(front.iter().map(|&p| Circle::new(p, 9, front_style)))?;

@@ -16,7 +16,7 @@ use super::error::TradeoffError;
 use super::measure::Measurement;
 use super::pareto::SAME_ERROR;
 use super::plot::{SOFTWARE, is_our_png, plot_png};
-use crate::film::write_file_atomic;
+use crate::atomic_write::write_file_atomic;
 use crate::stats::grouped;
 
 pub const CSV_FILE: &str = "tradeoff.csv";
@@ -267,6 +267,34 @@ pub fn significant(value: f64) -> String {
     } else {
         format!("{value:.*}", (2 - magnitude).max(0) as usize)
     }
+}
+
+/// What the terminal shows: the sweep's size, the bounce finding and the Pareto front.
+pub fn summary(t: &Tradeoff) -> String {
+    let front: Vec<String> = t
+        .front()
+        .map(|m| {
+            format!(
+                "{} ({} s, {} {})",
+                m.setting.label(),
+                significant(m.seconds),
+                t.metric.column(),
+                significant(t.metric.of(&m.errors))
+            )
+        })
+        .collect();
+    format!(
+        "{} at {}×{}: {} settings against a {} spp reference ({} bounces, {} s)\nbounces: {}\nPareto front: {}",
+        t.case_name,
+        t.width,
+        t.height,
+        t.measurements.len(),
+        t.reference.samples,
+        t.reference.bounces,
+        significant(t.reference.seconds),
+        bounce_sentence(t),
+        front.join(", ")
+    )
 }
 
 #[cfg(test)]

@@ -11,66 +11,13 @@
 
 use std::time::Duration;
 
-use indicatif::ProgressBar;
-
 use super::error::TradeoffError;
 use super::measure::{Measurement, Reference, Render, Renderer, errors};
-use crate::case::{Case, MAX_BOUNCES, MAX_IMAGE_SIZE};
+use super::setting::Setting;
+use crate::case::{Case, MAX_BOUNCES};
+use crate::image_size::{SizeLimit, check_side};
 use crate::options::{Filter, Precision};
-
-/// One point of the sweep: a value on every axis. Everything else (scene, size, seed, shadows)
-/// is the case's own, so two settings differ only in what the sweep varies.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Setting {
-    /// Per pixel (per sub-pixel with the Gaussian filter); a perfect square.
-    pub samples: u32,
-    pub filter: Filter,
-    pub bounces: u32,
-    pub precision: Precision,
-}
-
-impl Setting {
-    /// The setting the case file itself asks for.
-    pub fn of(case: &Case) -> Setting {
-        Setting {
-            samples: case.render.samples,
-            filter: case.render.filter,
-            bounces: case.render.bounces,
-            precision: case.render.precision,
-        }
-    }
-
-    /// A short name without commas (it is a CSV field and a plot label): `16spp gaussian 2b f32`.
-    pub fn label(&self) -> String {
-        format!(
-            "{}spp {} {}b {}",
-            self.samples,
-            self.filter.name(),
-            self.bounces,
-            self.precision.name()
-        )
-    }
-
-    /// Camera rays per output pixel: the part of the cost known before rendering, which weighs
-    /// the progress bar.
-    pub fn camera_rays_per_pixel(&self) -> u64 {
-        let subpixels = match self.filter {
-            Filter::None => 1,
-            Filter::Gaussian => 9,
-        };
-        u64::from(self.samples) * subpixels
-    }
-
-    /// The case with this setting in its `[render]` table.
-    pub fn apply(&self, case: &Case) -> Case {
-        let mut case = case.clone();
-        case.render.samples = self.samples;
-        case.render.filter = self.filter;
-        case.render.bounces = self.bounces;
-        case.render.precision = self.precision;
-        case
-    }
-}
+use crate::progress::Progress;
 
 /// The grid's filters unless told otherwise: both, since the filter is the costliest choice.
 pub const DEFAULT_FILTERS: [Filter; 2] = [Filter::None, Filter::Gaussian];
@@ -142,13 +89,12 @@ impl SweepPlan {
         if i64::from(self.max_bounces) > MAX_BOUNCES {
             return plan(format!("max bounces {}: at most {MAX_BOUNCES}", self.max_bounces));
         }
-        if let Some((width, height)) = self
-            .size
-            .filter(|&(w, h)| w == 0 || h == 0 || i64::from(w.max(h)) > MAX_IMAGE_SIZE)
-        {
-            return plan(format!(
-                "size {width}x{height}: each side must be between 1 and {MAX_IMAGE_SIZE}"
-            ));
+        if let Some((width, height)) = self.size {
+            for side in [width, height] {
+                if let Err(error) = check_side(side.into(), SizeLimit::Fixed) {
+                    return plan(format!("size {width}x{height}: each side {error}"));
+                }
+            }
         }
         if !(self.bounce_threshold.is_finite() && self.bounce_threshold >= 0.0) {
             return plan(format!(
@@ -218,21 +164,22 @@ pub struct Sweep {
 }
 
 /// Runs the bounce sweep, renders the reference, then the grid at the depth the bounce sweep
-/// found enough, advancing `bar` by each render's camera rays (its length is the estimate; the
+/// found enough, advancing `progress` by each render's camera rays (its total is the estimate; the
 /// bounce sweep adds to it as it goes deeper).
-pub fn run_sweep(case: &Case, plan: &SweepPlan, bar: &ProgressBar) -> Result<Sweep, TradeoffError> {
+pub fn run_sweep(case: &Case, plan: &SweepPlan, progress: &dyn Progress) -> Result<Sweep, TradeoffError> {
     let renderer = Renderer::new(case)?;
     let base = Setting::of(case);
     let pixels = renderer.pixels();
     let cost = |setting: &Setting| setting.camera_rays_per_pixel() * pixels;
     // The grid's camera rays do not depend on its bounces, so its cost is known before they are.
-    bar.set_length(
+    progress.begin(
+        "tradeoff",
         plan.grid(0).iter().map(cost).sum::<u64>() + u64::from(plan.reference_samples) * pixels + cost(&base),
     );
     let render = |setting: Setting| {
-        bar.set_message(setting.label());
+        progress.step(&setting.label());
         let rendered = renderer.render(setting, plan.min_time);
-        bar.inc(cost(&setting));
+        progress.advance(cost(&setting));
         rendered
     };
 
@@ -245,7 +192,7 @@ pub fn run_sweep(case: &Case, plan: &SweepPlan, bar: &ProgressBar) -> Result<Swe
     };
     for bounces in 0..=plan.max_bounces {
         if bounces > 0 {
-            bar.inc_length(cost(&base));
+            progress.grow(cost(&base));
         }
         let next = render(Setting { bounces, ..base });
         outcome.last = bounces;
@@ -259,9 +206,9 @@ pub fn run_sweep(case: &Case, plan: &SweepPlan, bar: &ProgressBar) -> Result<Swe
         }
     }
 
-    bar.set_message("reference");
+    progress.step(&format!("reference ({} spp)", plan.reference_samples));
     let reference = renderer.reference(plan.reference_samples, outcome.last);
-    bar.inc(u64::from(plan.reference_samples) * pixels);
+    progress.advance(u64::from(plan.reference_samples) * pixels);
 
     let grid = plan.grid(outcome.enough());
     let mut measurements: Vec<Measurement> = bounce_renders
@@ -272,7 +219,7 @@ pub fn run_sweep(case: &Case, plan: &SweepPlan, bar: &ProgressBar) -> Result<Swe
     for setting in grid {
         if measurements.iter().any(|m| m.setting == setting) {
             // Rendered by the bounce sweep, and already marked as part of the grid.
-            bar.inc(cost(&setting));
+            progress.advance(cost(&setting));
             continue;
         }
         measurements.push(Measurement::of(&render(setting), &reference, true, false)?);

@@ -10,7 +10,7 @@ use super::*;
 
 /// The centre pixel's colour and normal, rendered as `-size 3 3 [-bounces N] [-shadows]`.
 fn centre(scene: &str, bounces: u32, shadows: bool) -> ([u8; 3], [u8; 3]) {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/mit6837/reference.txt");
+    let path = data_dir().join("reference.txt");
     let options = AssignmentOptions {
         width: 3,
         height: 3,
@@ -20,7 +20,7 @@ fn centre(scene: &str, bounces: u32, shadows: bool) -> ([u8; 3], [u8; 3]) {
         ..AssignmentOptions::default()
     };
     let case = parse_assignment_scene(scene, &path, &options).unwrap_or_else(|e| panic!("{e}"));
-    let film = render_case(&case, false).unwrap_or_else(|e| panic!("{e}"));
+    let film = render_case(&case).unwrap_or_else(|e| panic!("{e}"));
     (
         color_image(&film, Tonemap::Clamp).get_pixel(1, 1).0,
         normals_image(&film, Tonemap::Clamp).get_pixel(1, 1).0,

@@ -286,7 +286,7 @@ fn phong_material_is_material_and_bump_is_read_and_ignored() {
 /// binary renders, all load here and survive the trip through TOML.
 #[test]
 fn generated_scenes_are_accepted_and_round_trip() {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/mit6837/generated.txt");
+    let path = data_dir().join("generated.txt");
     for seed in 1..=200 {
         let scene = generate::scene(seed);
         let case = parse_assignment_scene(&scene.text, &path, &AssignmentOptions::default())

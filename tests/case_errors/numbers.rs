@@ -35,7 +35,7 @@ fn image_size_is_bounded_unless_forced() {
         },
     )
     .unwrap();
-    assert_eq!((forced.render.width, forced.render.height), (100, 20000));
+    assert_eq!((forced.render.trace.width, forced.render.trace.height), (100, 20000));
     let message = error(&format!("[render]\nsize = [1, 2, 3]\n{CAMERA}"));
     assert_error(&message, "2:8", &["size must be [width, height], but has 3 elements"]);
 }

@@ -1,8 +1,7 @@
 //! A full case parses to exactly the expected values, and omitted settings get their defaults.
 
-use goldray::case::{
-    BackgroundSpec, CameraSpec, LightSpec, LoadOptions, MaterialSpec, ShapeSpec, Tolerance, TransformOp, load,
-};
+use goldray::case::{BackgroundSpec, CameraSpec, LightSpec, LoadOptions, MaterialSpec, ShapeSpec, TransformOp, load};
+use goldray::compare::Tolerance;
 use goldray::film::Tonemap;
 use goldray::options::{Filter, Profile};
 
@@ -106,9 +105,18 @@ fn a_full_case_parses_to_the_expected_values() {
         Some("every kind of object, light and transform op")
     );
     let r = &case.render;
-    assert_eq!((r.width, r.height, r.bounces, r.samples, r.seed), (320, 240, 3, 16, 7));
-    assert!(r.shadows && r.normals);
-    assert_eq!(r.filter, Filter::Gaussian);
+    assert_eq!(
+        (
+            r.trace.width,
+            r.trace.height,
+            r.trace.bounces,
+            r.trace.samples,
+            r.trace.seed
+        ),
+        (320, 240, 3, 16, 7)
+    );
+    assert!(r.trace.shadows && r.normals);
+    assert_eq!(r.trace.filter, Filter::Gaussian);
     assert_eq!(r.depth_range, Some((8.0, 18.0)));
     assert_eq!(r.profile, Profile::Mit6837);
     assert_eq!(
@@ -268,10 +276,19 @@ fn a_full_case_parses_to_the_expected_values() {
 fn a_minimal_case_gets_every_default() {
     let case = try_parse(CAMERA).unwrap();
     let r = &case.render;
-    assert_eq!((r.width, r.height, r.bounces, r.samples, r.seed), (200, 200, 0, 1, 0));
-    assert!(!r.shadows && !r.normals);
     assert_eq!(
-        (r.filter, r.profile, r.tonemap),
+        (
+            r.trace.width,
+            r.trace.height,
+            r.trace.bounces,
+            r.trace.samples,
+            r.trace.seed
+        ),
+        (200, 200, 0, 1, 0)
+    );
+    assert!(!r.trace.shadows && !r.normals);
+    assert_eq!(
+        (r.trace.filter, r.profile, r.tonemap),
         (Filter::None, Profile::Native, Tonemap::Srgb)
     );
     assert_eq!(r.depth_range, None);

@@ -42,9 +42,9 @@ impl Files {
         let at = nudged.index(100, 100);
         nudged.color[at][0] += 0.05;
         let mut without = with.clone();
-        without.render.shadows = false;
+        without.render.trace.shadows = false;
         let mut wider = with.clone();
-        wider.render.width += 1;
+        wider.render.trace.width += 1;
         for (name, film) in [
             ("golden", golden),
             ("nudged", nudged),

@@ -159,13 +159,8 @@ fn a_missing_file_is_named() {
 /// triangle hits something no farther than that triangle.
 #[test]
 fn course_meshes_load() {
-    let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/mit6837/data/models");
-    let entries = std::fs::read_dir(&models).unwrap_or_else(|e| {
-        panic!(
-            "../shared is missing: cannot read {} ({e}); the course data must be there",
-            models.display()
-        )
-    });
+    let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/mit6837/models");
+    let entries = std::fs::read_dir(&models).unwrap_or_else(|e| panic!("cannot read {} ({e})", models.display()));
     let mut paths: Vec<PathBuf> = entries
         .map(|entry| entry.unwrap().path())
         .filter(|path| path.extension().is_some_and(|ext| ext == "obj"))

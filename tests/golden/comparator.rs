@@ -10,8 +10,7 @@ use std::sync::{Arc, Mutex};
 use insta::internals::SnapshotContents;
 use insta::{Comparator, Snapshot};
 
-use goldray::case::Tolerance;
-use goldray::compare::{Comparison, Image, Verdict, compare, diff_heatmap};
+use goldray::compare::{Comparison, Image, Tolerance, Verdict, compare, diff_heatmap};
 use goldray::film::write_png;
 
 /// What the comparator made of a snapshot pair.

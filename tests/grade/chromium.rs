@@ -74,6 +74,19 @@ pub fn dump_dom(page: &Path) -> String {
     String::from_utf8(stdout).expect("the DOM is UTF-8")
 }
 
+/// [`dump_dom`] in a `width`×`height` window, for what depends on layout.
+pub fn dump_dom_at(page: &Path, width: u32, height: u32) -> String {
+    let stdout = run(
+        page,
+        &[
+            "--virtual-time-budget=5000".to_owned(),
+            format!("--window-size={width},{height}"),
+            "--dump-dom".to_owned(),
+        ],
+    );
+    String::from_utf8(stdout).expect("the DOM is UTF-8")
+}
+
 /// A screenshot of the page in a `width`×`height` window.
 pub fn screenshot(page: &Path, width: u32, height: u32, file: &Path) -> image::RgbImage {
     run(

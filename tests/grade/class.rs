@@ -71,7 +71,7 @@ fn case() -> Case {
 }
 
 fn render(case: &Case) -> Film {
-    render_case(case, false).unwrap_or_else(|e| panic!("{e}"))
+    render_case(case).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Colour, normals and depth as the course binary writes them.
@@ -172,7 +172,7 @@ pub fn make_class_at(dir: &Path) -> Class {
     students.push(("perfect", all(perfect_png.clone())));
 
     let mut no_shadows = base.clone();
-    no_shadows.render.shadows = false;
+    no_shadows.render.trace.shadows = false;
     students.push(("no_shadows", all(pictures(&render(&no_shadows)).each_ref().map(png))));
 
     let mut shifted = base.clone();
@@ -201,7 +201,7 @@ pub fn make_class_at(dir: &Path) -> Class {
     ));
 
     let mut small = base.clone();
-    (small.render.width, small.render.height) = (120, 90);
+    (small.render.trace.width, small.render.trace.height) = (120, 90);
     students.push(("wrong_sizes", all(pictures(&render(&small)).each_ref().map(png))));
 
     students.push((

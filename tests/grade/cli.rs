@@ -5,6 +5,7 @@ use std::path::Path;
 use std::process::Command;
 
 use goldray::grade::{ClassReport, GradeOptions, grade_class};
+use goldray::progress::Silent;
 
 use crate::class::make_class;
 
@@ -16,9 +17,8 @@ fn goldens_are_rendered_once_then_read_from_the_cache() {
         let options = GradeOptions {
             out: class.dir.join(out),
             cache: Some(cache.clone()),
-            show_progress: false,
         };
-        grade_class(&class.rubric, &class.submissions, &options).unwrap_or_else(|e| panic!("{e}"))
+        grade_class(&class.rubric, &class.submissions, &options, &Silent).unwrap_or_else(|e| panic!("{e}"))
     };
     let first = grade("first");
     assert_eq!(first.goldens.len(), 1, "three images, one render");
@@ -38,9 +38,12 @@ fn goldens_are_rendered_once_then_read_from_the_cache() {
     );
 }
 
-fn goldray(args: &[&str]) -> std::process::Output {
+/// Runs goldray with the user cache folder (where golden renders go by default) at `cache_home`,
+/// so that tests never touch the real one.
+fn goldray(args: &[&str], cache_home: &Path) -> std::process::Output {
     Command::new(env!("CARGO_BIN_EXE_goldray"))
         .args(args)
+        .env("XDG_CACHE_HOME", cache_home)
         .output()
         .expect("the goldray binary runs")
 }
@@ -50,16 +53,19 @@ fn the_command_exits_0_whatever_the_grades_and_1_when_it_cannot_grade() {
     let class = make_class();
     let out = class.dir.join("cli-report");
     let path = |p: &Path| p.to_str().unwrap().to_owned();
-    let run = goldray(&[
-        "grade",
-        "--rubric",
-        &path(&class.rubric),
-        &path(&class.submissions),
-        "--out",
-        &path(&out),
-        "--jobs",
-        "2",
-    ]);
+    let run = goldray(
+        &[
+            "grade",
+            "--rubric",
+            &path(&class.rubric),
+            &path(&class.submissions),
+            "--out",
+            &path(&out),
+            "--jobs",
+            "2",
+        ],
+        &class.dir.join("user-cache"),
+    );
     assert_eq!(run.status.code(), Some(0), "{}", String::from_utf8_lossy(&run.stderr));
     let stdout = String::from_utf8_lossy(&run.stdout);
     assert!(
@@ -69,16 +75,31 @@ fn the_command_exits_0_whatever_the_grades_and_1_when_it_cannot_grade() {
     for file in ["grades.csv", "grades.json", "index.html", "golden/color.png"] {
         assert!(out.join(file).is_file(), "{file} missing");
     }
+    // The golden cache lives in the user cache folder, not in the report that gets zipped and sent.
+    let cache = class.dir.join("user-cache/goldray/goldens");
+    assert!(!out.join("cache").exists(), "no cache inside the report");
+    assert!(
+        fs::read_dir(&cache).is_ok_and(|mut entries| entries.next().is_some()),
+        "goldens cached in {}",
+        cache.display()
+    );
+    assert!(
+        stdout.contains(&cache.display().to_string()),
+        "the summary says where: {stdout}"
+    );
 
-    let missing = goldray(&[
-        "grade",
-        "--rubric",
-        &path(&class.rubric),
-        "/nonexistent/submissions",
-        "--out",
-        &path(&out),
-        "--quiet",
-    ]);
+    let missing = goldray(
+        &[
+            "grade",
+            "--rubric",
+            &path(&class.rubric),
+            "/nonexistent/submissions",
+            "--out",
+            &path(&out),
+            "--quiet",
+        ],
+        &class.dir.join("user-cache"),
+    );
     assert_eq!(missing.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&missing.stderr).contains("/nonexistent/submissions"));
 
@@ -90,15 +111,18 @@ fn the_command_exits_0_whatever_the_grades_and_1_when_it_cannot_grade() {
             .replace("points = 2", "pionts = 2"),
     )
     .unwrap();
-    let run = goldray(&[
-        "grade",
-        "--rubric",
-        &path(&bad),
-        &path(&class.submissions),
-        "--out",
-        &path(&out),
-        "--quiet",
-    ]);
+    let run = goldray(
+        &[
+            "grade",
+            "--rubric",
+            &path(&bad),
+            &path(&class.submissions),
+            "--out",
+            &path(&out),
+            "--quiet",
+        ],
+        &class.dir.join("user-cache"),
+    );
     assert_eq!(run.status.code(), Some(1));
     let message = String::from_utf8_lossy(&run.stderr);
     assert!(

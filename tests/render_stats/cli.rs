@@ -152,23 +152,27 @@ fn every_shipped_case_reports_statistics() {
         );
         let json = read_json(&json_path);
         let settings = &case.render;
-        let pixels = u64::from(settings.width) * u64::from(settings.height);
-        let subpixels = if settings.filter == Filter::Gaussian { 9 } else { 1 };
-        let averaged = settings.samples > 1 || settings.filter == Filter::Gaussian;
+        let pixels = u64::from(settings.trace.width) * u64::from(settings.trace.height);
+        let subpixels = if settings.trace.filter == Filter::Gaussian {
+            9
+        } else {
+            1
+        };
+        let averaged = settings.trace.samples > 1 || settings.trace.filter == Filter::Gaussian;
         assert_eq!(
             count(&json, "camera"),
-            pixels * subpixels * u64::from(settings.samples),
+            pixels * subpixels * u64::from(settings.trace.samples),
             "{}",
             case.name
         );
         assert_eq!(count(&json, "aov"), if averaged { pixels } else { 0 }, "{}", case.name);
         assert_eq!(
             count(&json, "shadow") > 0,
-            settings.shadows && !case.lights.is_empty(),
+            settings.trace.shadows && !case.lights.is_empty(),
             "{}",
             case.name
         );
-        if settings.bounces == 0 {
+        if settings.trace.bounces == 0 {
             assert_eq!(count(&json, "reflection"), 0, "{}", case.name);
         }
         for mesh in json["meshes"].as_array().unwrap() {

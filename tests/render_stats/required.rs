@@ -3,7 +3,7 @@
 
 use goldray::options::RenderOptions;
 use goldray::pipeline::render_options;
-use goldray::progress::Progress;
+use goldray::progress::Silent;
 use goldray::render::render_counting_rays;
 use goldray::scene::build_scene;
 use goldray::stats::RayCounts;
@@ -57,8 +57,8 @@ fn no_aov_rays_when_no_aov_is_written() {
         let with = render_options(&case);
         assert!(with.aovs, "a case always writes its EXR, with depth and normals");
         let without = RenderOptions { aovs: false, ..with };
-        let (film, counts) = render_counting_rays(&scene, &with, &Progress::hidden());
-        let (bare, bare_counts) = render_counting_rays(&scene, &without, &Progress::hidden());
+        let (film, counts) = render_counting_rays(&scene, &with, &Silent);
+        let (bare, bare_counts) = render_counting_rays(&scene, &without, &Silent);
         assert_eq!(bare_counts.aov, 0, "{render:?}");
         assert_eq!(bare_counts, RayCounts { aov: 0, ..counts }, "{render:?}");
         assert!(bare.color == film.color, "{render:?}: the AOVs changed the colour");

@@ -2,15 +2,22 @@
 //! anything renders or is written), and what the command prints.
 
 use std::path::PathBuf;
+use std::process::ExitCode;
 use std::time::Duration;
 
-use super::error::TradeoffError;
-use super::measure::Metric;
-use super::report::significant;
-use super::sweep::{DEFAULT_FILTERS, SweepPlan};
-use super::{Tradeoff, TradeoffOptions, run_tradeoff};
-use crate::case::{MAX_BOUNCES, MAX_IMAGE_SIZE, case_name};
-use crate::options::{Filter, Precision};
+use goldray::case::{MAX_BOUNCES, case_name};
+use goldray::options::{Filter, Precision};
+use goldray::tradeoff::{Metric, SweepPlan, TradeoffOptions, run_tradeoff, summary};
+
+use super::Failure;
+use super::common::{ThreadFlags, parse_named, parse_size, parse_threshold};
+use super::progress::Reporter;
+
+// The list defaults as the flags accept them (help shows them as written); a test checks they
+// are the library's defaults.
+const DEFAULT_SAMPLES: &str = "1,4,16,64,256";
+const DEFAULT_FILTER_LIST: &str = "none,gaussian";
+const DEFAULT_PRECISIONS: &str = "f32,f64";
 
 /// Render a case over a sweep of samples, filters, precisions and bounces; measure each setting's time, rays
 /// and error against a converged reference; write tradeoff.csv, tradeoff.md and a log-log plot
@@ -28,15 +35,15 @@ pub struct TradeoffArgs {
     pub target_flip: Option<f64>,
     /// Samples per pixel of the grid: comma-separated perfect squares (e.g. 1,4,16).
     #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_square,
-          default_values_t = SweepPlan::default().samples)]
+          default_value = DEFAULT_SAMPLES)]
     pub samples: Vec<u32>,
     /// Filters of the grid: comma-separated, from none and gaussian (3× supersampling, 9× the rays).
-    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_filter,
-          default_values = DEFAULT_FILTERS.map(Filter::name))]
+    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_named::<Filter>,
+          default_value = DEFAULT_FILTER_LIST)]
     pub filters: Vec<Filter>,
     /// Precisions of the grid: comma-separated, from f32 and f64 (the reference is always f64).
-    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_precision,
-          default_values = Precision::ALL.map(Precision::name))]
+    #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_named::<Precision>,
+          default_value = DEFAULT_PRECISIONS)]
     pub precisions: Vec<Precision>,
     /// Render every setting and the reference at this size instead of the case's (e.g. 64x48):
     /// a quicker sweep.
@@ -60,12 +67,13 @@ pub struct TradeoffArgs {
     #[arg(long, value_name = "S", value_parser = parse_seconds,
           default_value_t = SweepPlan::default().min_time.as_secs_f64())]
     pub min_time: f64,
-    /// The error the plot and the Pareto front rank settings by.
-    #[arg(long, value_enum, default_value_t = Metric::Rmse)]
+    /// The error the plot and the Pareto front rank settings by: rmse (RMSE on linear colour; its
+    /// log-log slope against samples is the convergence rate), max (the largest error of any
+    /// channel of any pixel) or flip (the FLIP mean: what a viewer would notice).
+    #[arg(long, value_name = "METRIC", value_parser = parse_named::<Metric>, default_value = "rmse")]
     pub metric: Metric,
-    /// Worker threads (default: one per core). Times depend on it; pictures and rays do not.
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
-    pub threads: Option<u32>,
+    #[command(flatten)]
+    pub threads: ThreadFlags,
     /// No progress bar and no summary (the --target-flip answer is still printed).
     #[arg(long)]
     pub quiet: bool,
@@ -75,7 +83,7 @@ pub struct TradeoffArgs {
 }
 
 impl TradeoffArgs {
-    pub fn options(&self) -> TradeoffOptions {
+    fn options(&self) -> TradeoffOptions {
         TradeoffOptions {
             out: self
                 .out
@@ -94,19 +102,17 @@ impl TradeoffArgs {
             metric: self.metric,
             target_flip: self.target_flip,
             force: self.force,
-            show_progress: !self.quiet,
         }
     }
 }
 
 /// Runs `goldray tradeoff` on its own thread pool and prints the summary to standard output.
-pub fn run_tradeoff_command(args: &TradeoffArgs) -> Result<Tradeoff, TradeoffError> {
-    let mut pool = rayon::ThreadPoolBuilder::new();
-    if let Some(threads) = args.threads {
-        pool = pool.num_threads(threads as usize);
-    }
+pub fn run(args: TradeoffArgs) -> Result<ExitCode, Failure> {
     let options = args.options();
-    let (tradeoff, written) = pool.build()?.install(|| run_tradeoff(&args.case, &options))?;
+    let reporter = Reporter::new(args.quiet);
+    let (tradeoff, written) = args
+        .threads
+        .install(|| run_tradeoff(&args.case, &options, &reporter))??;
     if !args.quiet {
         println!("{}", summary(&tradeoff));
         for path in &written {
@@ -116,35 +122,7 @@ pub fn run_tradeoff_command(args: &TradeoffArgs) -> Result<Tradeoff, TradeoffErr
     if let Some(sentence) = tradeoff.target_sentence() {
         println!("target: {sentence}");
     }
-    Ok(tradeoff)
-}
-
-/// What the terminal shows: the sweep's size, the bounce finding and the Pareto front.
-fn summary(t: &Tradeoff) -> String {
-    let front: Vec<String> = t
-        .front()
-        .map(|m| {
-            format!(
-                "{} ({} s, {} {})",
-                m.setting.label(),
-                significant(m.seconds),
-                t.metric.name(),
-                significant(t.metric.of(&m.errors))
-            )
-        })
-        .collect();
-    format!(
-        "{} at {}×{}: {} settings against a {} spp reference ({} bounces, {} s)\nbounces: {}\nPareto front: {}",
-        t.case_name,
-        t.width,
-        t.height,
-        t.measurements.len(),
-        t.reference.samples,
-        t.reference.bounces,
-        significant(t.reference.seconds),
-        super::report::bounce_sentence(t),
-        front.join(", ")
-    )
+    Ok(ExitCode::SUCCESS)
 }
 
 fn parse_square(text: &str) -> Result<u32, String> {
@@ -164,37 +142,6 @@ fn parse_square(text: &str) -> Result<u32, String> {
     Ok(n)
 }
 
-fn parse_filter(text: &str) -> Result<Filter, String> {
-    match text.trim() {
-        "none" => Ok(Filter::None),
-        "gaussian" => Ok(Filter::Gaussian),
-        other => Err(format!("`{other}` is not a filter: none or gaussian")),
-    }
-}
-
-fn parse_precision(text: &str) -> Result<Precision, String> {
-    let text = text.trim();
-    Precision::ALL
-        .into_iter()
-        .find(|p| p.name() == text)
-        .ok_or_else(|| format!("`{text}` is not a precision: f32 or f64"))
-}
-
-fn parse_size(text: &str) -> Result<(u32, u32), String> {
-    let usage = || format!("`{text}` is not a size: give WIDTHxHEIGHT, e.g. 64x48");
-    let (width, height) = text.split_once(['x', 'X', '×']).ok_or_else(usage)?;
-    let side = |s: &str| {
-        s.trim()
-            .parse::<u32>()
-            .ok()
-            .filter(|&v| v >= 1 && i64::from(v) <= MAX_IMAGE_SIZE)
-    };
-    match (side(width), side(height)) {
-        (Some(w), Some(h)) => Ok((w, h)),
-        _ => Err(format!("{} (each side between 1 and {MAX_IMAGE_SIZE})", usage())),
-    }
-}
-
 fn parse_flip(text: &str) -> Result<f64, String> {
     match text.trim().parse::<f64>() {
         Ok(x) if (0.0..=1.0).contains(&x) => Ok(x),
@@ -209,16 +156,30 @@ fn parse_seconds(text: &str) -> Result<f64, String> {
     }
 }
 
-fn parse_threshold(text: &str) -> Result<f64, String> {
-    match text.trim().parse::<f64>() {
-        Ok(x) if x.is_finite() && x >= 0.0 => Ok(x),
-        _ => Err(format!("`{text}` is not a threshold: a finite number ≥ 0")),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use goldray::tradeoff::DEFAULT_FILTERS;
+
+    #[test]
+    fn list_defaults_are_the_library_defaults_in_the_syntax_the_flags_take() {
+        let split = |list: &str| list.split(',').map(str::to_owned).collect::<Vec<_>>();
+        let samples: Vec<u32> = split(DEFAULT_SAMPLES)
+            .iter()
+            .map(|s| parse_square(s).unwrap())
+            .collect();
+        assert_eq!(samples, SweepPlan::default().samples);
+        let filters: Vec<Filter> = split(DEFAULT_FILTER_LIST)
+            .iter()
+            .map(|s| parse_named::<Filter>(s).unwrap())
+            .collect();
+        assert_eq!(filters, DEFAULT_FILTERS);
+        let precisions: Vec<Precision> = split(DEFAULT_PRECISIONS)
+            .iter()
+            .map(|s| parse_named::<Precision>(s).unwrap())
+            .collect();
+        assert_eq!(precisions, Precision::ALL);
+    }
 
     #[test]
     fn flag_values_are_checked_with_reasons() {
@@ -226,17 +187,12 @@ mod tests {
         assert!(parse_square("8").unwrap_err().contains("nearest are 4 and 9"));
         assert!(parse_square("0").unwrap_err().contains("perfect square"));
         assert!(parse_square("four").unwrap_err().contains("whole number"));
-        assert_eq!(parse_size("64x48"), Ok((64, 48)));
-        assert!(parse_size("64").unwrap_err().contains("WIDTHxHEIGHT"));
-        assert!(parse_size("0x10").unwrap_err().contains("between 1"));
-        assert!(parse_size("99999x10").unwrap_err().contains("16384"));
-        assert_eq!(parse_filter("gaussian"), Ok(Filter::Gaussian));
-        assert!(parse_filter("box").unwrap_err().contains("none or gaussian"));
-        assert_eq!(parse_precision("f64"), Ok(Precision::F64));
-        assert!(parse_precision("f16").unwrap_err().contains("f32 or f64"));
+        assert_eq!(parse_named::<Filter>("gaussian"), Ok(Filter::Gaussian));
+        assert!(parse_named::<Filter>("box").unwrap_err().contains("none or gaussian"));
+        assert_eq!(parse_named::<Precision>("f64"), Ok(Precision::F64));
+        assert!(parse_named::<Precision>("f16").unwrap_err().contains("f32 or f64"));
         assert_eq!(parse_flip("0.05"), Ok(0.05));
         assert!(parse_flip("1.5").is_err() && parse_flip("nan").is_err());
-        assert!(parse_threshold("-1").is_err() && parse_threshold("inf").is_err());
         assert_eq!(parse_seconds("0"), Ok(0.0));
         assert!(parse_seconds("-0.5").is_err() && parse_seconds("nan").is_err());
     }

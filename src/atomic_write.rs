@@ -1,0 +1,223 @@
+//! Replacing files so that readers see the old content or the new, never a mix, and a set of files
+//! all-or-nothing, so that a failed or interrupted run never leaves a new EXR beside an old PNG.
+//!
+//! A leaf module: renders, statistics, reports and exported cases all write through it.
+
+use std::fs::{self, File};
+use std::io::{self, Write};
+use std::path::{Path, PathBuf};
+
+/// Why a file could not be replaced. Messages name the file the caller asked for, never the
+/// temporary file beside it.
+#[derive(Debug, thiserror::Error)]
+pub enum AtomicWriteError {
+    #[error("cannot write {}: {source}", path.display())]
+    Write { path: PathBuf, source: io::Error },
+
+    #[error(
+        "{failure}; then restoring {} failed too: {source} (the previous outputs are kept in {})",
+        path.display(),
+        kept.display()
+    )]
+    Rollback {
+        failure: Box<AtomicWriteError>,
+        path: PathBuf,
+        kept: PathBuf,
+        source: io::Error,
+    },
+}
+
+/// Replaces `path` with `bytes` so that readers see the old content or the new, never a mix,
+/// and a crash leaves the old file intact: the bytes go to a synced temporary file beside `path`,
+/// which is then renamed over it. Creates the parent directory if missing.
+pub fn write_file_atomic(path: &Path, bytes: &[u8]) -> Result<(), AtomicWriteError> {
+    write_files_atomic(parent_folder(path), &[(path, bytes)])
+}
+
+/// Checks, before any work is spent on it, that `path` could be written: it is not a folder, and
+/// its folder (or, when that is missing, the nearest existing folder above it, since writing
+/// creates missing folders) accepts a new file. The error names `path`, never a temporary file.
+pub fn check_writable(path: &Path) -> Result<(), AtomicWriteError> {
+    if path.is_dir() {
+        return Err(AtomicWriteError::Write {
+            path: path.to_path_buf(),
+            source: io::ErrorKind::IsADirectory.into(),
+        });
+    }
+    check_folder_writable(parent_folder(path)).map_err(|source| AtomicWriteError::Write {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// [`check_writable`] for a folder that files will be written into (created if missing).
+pub fn check_writable_folder(folder: &Path) -> Result<(), AtomicWriteError> {
+    check_folder_writable(folder).map_err(|source| AtomicWriteError::Write {
+        path: folder.to_path_buf(),
+        source,
+    })
+}
+
+fn check_folder_writable(folder: &Path) -> io::Result<()> {
+    let mut existing = folder;
+    while fs::symlink_metadata(existing).is_err() {
+        match existing.parent() {
+            Some(parent) if !parent.as_os_str().is_empty() => existing = parent,
+            _ => {
+                existing = Path::new(".");
+                break;
+            }
+        }
+    }
+    if !existing.is_dir() {
+        return Err(io::Error::new(
+            io::ErrorKind::NotADirectory,
+            format!("{} is not a folder", existing.display()),
+        ));
+    }
+    tempfile::Builder::new()
+        .prefix(".goldray-check-")
+        .tempfile_in(existing)
+        .map(drop)
+}
+
+fn parent_folder(path: &Path) -> &Path {
+    match path.parent() {
+        Some(parent) if !parent.as_os_str().is_empty() => parent,
+        _ => Path::new("."),
+    }
+}
+
+/// A target that has been replaced, and how to undo that.
+struct Installed<'a> {
+    target: &'a Path,
+    /// A hard link to (or copy of) the file it replaced; `None` when there was none.
+    previous: Option<PathBuf>,
+}
+
+/// Replaces every `(target, bytes)` pair, all or nothing: stages every file in a temporary directory inside `dir` (same filesystem, so renames are
+/// atomic), then renames them over their targets in order, undoing the earlier renames if a later
+/// one fails. The staging directory, with any backups, is removed on the way out.
+pub fn write_files_atomic(dir: &Path, files: &[(&Path, &[u8])]) -> Result<(), AtomicWriteError> {
+    let dir_error = |source| AtomicWriteError::Write {
+        path: dir.to_path_buf(),
+        source,
+    };
+    fs::create_dir_all(dir).map_err(dir_error)?;
+    let staging = tempfile::Builder::new()
+        .prefix(".goldray-")
+        .tempdir_in(dir)
+        .map_err(dir_error)?;
+
+    let mut staged = Vec::with_capacity(files.len());
+    for (i, &(target, bytes)) in files.iter().enumerate() {
+        let temp = staging.path().join(i.to_string());
+        write_synced(&temp, bytes).map_err(|source| AtomicWriteError::Write {
+            path: target.to_path_buf(),
+            source,
+        })?;
+        staged.push(temp);
+    }
+
+    let mut installed: Vec<Installed> = Vec::with_capacity(files.len());
+    for (i, (&(target, _), temp)) in files.iter().zip(&staged).enumerate() {
+        // The last target is never rolled back, so its old content needs no backup.
+        let needs_backup = i + 1 < files.len();
+        let backup = staging.path().join(format!("{i}.previous"));
+        let result =
+            preserve(target, &backup, needs_backup).and_then(|previous| fs::rename(temp, target).map(|()| previous));
+        match result {
+            Ok(previous) => installed.push(Installed { target, previous }),
+            Err(source) => {
+                let failure = AtomicWriteError::Write {
+                    path: target.to_path_buf(),
+                    source,
+                };
+                return Err(roll_back(installed, staging, failure));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Keeps the current content of `target` at `backup` (when asked to and there is any), refusing a
+/// directory in the way with a clearer message than the rename's.
+fn preserve(target: &Path, backup: &Path, needs_backup: bool) -> io::Result<Option<PathBuf>> {
+    match fs::symlink_metadata(target) {
+        Err(error) if error.kind() == io::ErrorKind::NotFound => Ok(None),
+        Err(error) => Err(error),
+        Ok(meta) if meta.is_dir() => Err(io::ErrorKind::IsADirectory.into()),
+        Ok(_) if !needs_backup => Ok(None),
+        Ok(_) => {
+            // A hard link costs nothing; filesystems without them get a copy.
+            if fs::hard_link(target, backup).is_err() {
+                fs::copy(target, backup)?;
+            }
+            Ok(Some(backup.to_path_buf()))
+        }
+    }
+}
+
+/// Undoes `installed` newest first. Should that fail too, the staging directory is kept so that
+/// the previous content is not lost, and the error says where it is.
+fn roll_back(installed: Vec<Installed>, staging: tempfile::TempDir, failure: AtomicWriteError) -> AtomicWriteError {
+    for Installed { target, previous } in installed.into_iter().rev() {
+        let undone = match &previous {
+            Some(backup) => fs::rename(backup, target),
+            None => fs::remove_file(target),
+        };
+        if let Err(source) = undone {
+            return AtomicWriteError::Rollback {
+                failure: Box::new(failure),
+                path: target.to_path_buf(),
+                kept: staging.keep(),
+                source,
+            };
+        }
+    }
+    failure
+}
+
+fn write_synced(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    let mut file = File::create(path)?;
+    file.write_all(bytes)?;
+    file.sync_all()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn writability_is_checked_at_the_nearest_existing_folder_and_names_the_path_given() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        assert!(check_writable(&dir.path().join("a.png")).is_ok());
+        assert!(check_writable(&dir.path().join("new/deeper/a.png")).is_ok());
+        assert!(check_writable_folder(&dir.path().join("new")).is_ok());
+        let error = check_writable(dir.path()).unwrap_err().to_string();
+        assert!(
+            error.starts_with(&format!("cannot write {}", dir.path().display())),
+            "{error}"
+        );
+        fs::write(dir.path().join("file"), b"x").expect("write");
+        let error = check_writable(&dir.path().join("file/a.png")).unwrap_err().to_string();
+        assert!(
+            error.contains("file/a.png") && error.contains("is not a folder"),
+            "{error}"
+        );
+        assert_eq!(
+            fs::read_dir(dir.path()).expect("list").count(),
+            1,
+            "a check leaves nothing behind"
+        );
+    }
+
+    #[test]
+    fn messages_name_the_file_and_the_problem() {
+        let error = AtomicWriteError::Write {
+            path: PathBuf::from("out/a.exr"),
+            source: io::Error::from(io::ErrorKind::PermissionDenied),
+        };
+        assert_eq!(error.to_string(), "cannot write out/a.exr: permission denied");
+    }
+}

@@ -1,0 +1,107 @@
+//! goldray's command line: every flag, every check of a flag's value, and everything printed.
+//! The library below neither parses flags nor prints; each command here is one file that turns
+//! flags into library options, runs the library, and reports.
+
+mod common;
+mod course_flags;
+mod diff;
+mod grade;
+mod import;
+mod mit6837;
+mod progress;
+mod render;
+mod tradeoff;
+
+use std::process::ExitCode;
+
+use clap::{CommandFactory, Parser, Subcommand};
+
+/// A deterministic Whitted ray tracer and scene-to-image regression harness.
+#[derive(Parser)]
+#[command(name = "goldray", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a TOML case to DIR/NAME.exr and DIR/NAME.png (plus depth and normal PNGs when the
+    /// case asks for them).
+    Render(render::RenderArgs),
+    /// Drop-in replacement for the course's ray tracer binary, with its single-dash flags.
+    #[command(override_usage = mit6837::USAGE)]
+    Mit6837(mit6837::Mit6837Args),
+    /// Convert a course scene file to the equivalent TOML case (takes the course's render flags).
+    Import(import::ImportArgs),
+    /// Compare two EXR or PNG images within a tolerance. Exit code: 0 pass, 1 warn (some pixels
+    /// over --pixel, every limit kept), 2 fail, 3 size or channel mismatch, 4 unreadable file.
+    Diff(diff::DiffArgs),
+    /// Grade folders of student renders against a rubric's golden images: writes grades.csv,
+    /// grades.json and an HTML report. Exit code 0 whenever grading ran, whatever the grades.
+    Grade(grade::GradeArgs),
+    /// Measure the speed-accuracy trade: render a case over samples × filter × precision and
+    /// bounces, time each setting and count its rays, measure its error against a converged
+    /// reference, and write tradeoff.csv, tradeoff.md and a log-log plot tradeoff.png with the
+    /// Pareto front.
+    Tradeoff(tradeoff::TradeoffArgs),
+}
+
+/// Why a command stopped: a command line that cannot be right (exit code 2, like clap's own
+/// errors) or a failure while running (exit code 1).
+pub enum Failure {
+    Usage(String),
+    Run(String),
+}
+
+impl<E: std::fmt::Display> From<E> for Failure {
+    fn from(error: E) -> Failure {
+        Failure::Run(error.to_string())
+    }
+}
+
+/// `goldray mit6837 --help` (or `-help`, or `goldray help mit6837`).
+fn asks_for_course_help(args: &[std::ffi::OsString]) -> bool {
+    match args.get(1).and_then(|a| a.to_str()) {
+        Some("mit6837") => true,
+        Some("help") => args.get(2).is_some_and(|a| a == "mit6837"),
+        _ => false,
+    }
+}
+
+/// Parses the command line (rewriting the course's single-dash flags first), runs the command
+/// and turns its outcome into the process's exit code.
+pub fn main() -> ExitCode {
+    let args = course_flags::rewrite(std::env::args_os());
+    let cli = match Cli::try_parse_from(&args) {
+        Ok(cli) => cli,
+        Err(error) if error.kind() == clap::error::ErrorKind::DisplayHelp && asks_for_course_help(&args) => {
+            let help = Cli::command()
+                .find_subcommand_mut("mit6837")
+                .map(|command| command.render_help().to_string())
+                .unwrap_or_default();
+            print!("{}", mit6837::course_style_help(&help));
+            return ExitCode::SUCCESS;
+        }
+        Err(error) => error.exit(),
+    };
+    let outcome = match cli.command {
+        Command::Render(args) => render::run(args),
+        Command::Mit6837(args) => mit6837::run(args),
+        Command::Import(args) => import::run(args),
+        Command::Diff(args) => Ok(diff::run(args)),
+        Command::Grade(args) => grade::run(args),
+        Command::Tradeoff(args) => tradeoff::run(args),
+    };
+    match outcome {
+        Ok(code) => code,
+        Err(Failure::Usage(message)) => {
+            eprintln!("error: {message}");
+            ExitCode::from(2)
+        }
+        Err(Failure::Run(message)) => {
+            eprintln!("error: {message}");
+            ExitCode::FAILURE
+        }
+    }
+}
