@@ -372,7 +372,13 @@ fn import_to_standard_output_works_wherever_the_output_is_saved() {
     fs::create_dir_all(saved.parent().unwrap()).unwrap();
     fs::write(&saved, &text).unwrap();
     let out = dir.path().join("out");
-    let render = goldray(&["render", saved.to_str().unwrap(), "--out", out.to_str().unwrap(), "--quiet"]);
+    let render = goldray(&[
+        "render",
+        saved.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
     assert!(render.status.success(), "{}", stderr(&render));
     assert!(out.join("case.png").is_file());
 }
