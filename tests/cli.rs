@@ -207,6 +207,9 @@ fn a_bad_command_line_exits_2_on_every_command() {
     );
     let unknown = goldray(&["render", "x.toml", "--no-such-flag"]);
     assert_eq!(unknown.status.code(), Some(2));
+    let bad_size = goldray(&["tradeoff", case("jitter.toml").to_str().unwrap(), "--size", "0", "10"]);
+    assert_eq!(bad_size.status.code(), Some(2), "{}", stderr(&bad_size));
+    assert!(stderr(&bad_size).contains("size 0 10: each side must be between 1 and 16384"));
     let bad_pixel = goldray(&["diff", "a.png", "b.png", "--pixel", "nan"]);
     assert_eq!(bad_pixel.status.code(), Some(2));
     assert!(!Path::new("x.png").exists());
