@@ -3,22 +3,10 @@
 
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn goldray(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_goldray"))
-        .args(args)
-        .output()
-        .expect("the goldray binary runs")
-}
+mod util;
 
-fn case(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("cases").join(name)
-}
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
-}
+use util::{goldray, shipped as case, stderr};
 
 fn files_in(dir: &Path) -> Vec<String> {
     let mut names: Vec<String> = match fs::read_dir(dir) {

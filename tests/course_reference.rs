@@ -2,6 +2,8 @@
 //! against the imported TOML case. Reads the course's scenes from `cases/mit6837/` and its
 //! reference images from `tests/data/mit6837/`.
 
+mod util;
+
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -23,16 +25,10 @@ fn reference_path(file: &str) -> PathBuf {
         .join(file)
 }
 
+/// Runs goldray and insists that it succeeded.
 fn goldray(args: &[&str]) -> Output {
-    let output = Command::new(env!("CARGO_BIN_EXE_goldray"))
-        .args(args)
-        .output()
-        .expect("the goldray binary runs");
-    assert!(
-        output.status.success(),
-        "goldray {args:?}: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
+    let output = util::goldray(args);
+    assert!(output.status.success(), "goldray {args:?}: {}", util::stderr(&output));
     output
 }
 
