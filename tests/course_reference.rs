@@ -187,7 +187,7 @@ fn drop_in_command_and_imported_case_give_identical_files() {
 #[test]
 fn the_course_command_line_rejects_what_the_course_binary_would() {
     let input = scene_path("scene01_plane.txt");
-    let run = |args: &[&str]| Command::new(env!("CARGO_BIN_EXE_goldray")).args(args).output().unwrap();
+    let run = util::goldray;
     let unknown = run(&[
         "mit6837",
         "-input",
