@@ -10,6 +10,8 @@ mod chromium;
 mod class;
 #[path = "grade/cli.rs"]
 mod cli;
+#[path = "grade/integrity.rs"]
+mod integrity;
 #[path = "grade/rubrics.rs"]
 mod rubrics;
 
@@ -186,14 +188,18 @@ fn grades_csv_parses_back_to_the_report() {
     let text = fs::read_to_string(out.join("grades.csv")).unwrap();
     let rows = parse_csv(&text);
     let header: Vec<&str> = rows[0].iter().map(String::as_str).collect();
-    assert_eq!(header, ["student", "color.png", "normals.png", "depth.png", "total"]);
+    assert_eq!(
+        header,
+        ["student", "color.png", "normals.png", "depth.png", "total", "flags"]
+    );
     assert_eq!(rows.len(), report.students.len() + 1, "one row per student");
     let by_name: BTreeMap<&str, &Vec<String>> = rows[1..].iter().map(|r| (r[0].as_str(), r)).collect();
     for s in &report.students {
         let row = by_name
             .get(s.name.as_str())
             .unwrap_or_else(|| panic!("{} has no row:\n{text}", s.name));
-        let numbers: Vec<f64> = row[1..].iter().map(|v| v.parse().unwrap()).collect();
+        let numbers: Vec<f64> = row[1..row.len() - 1].iter().map(|v| v.parse().unwrap()).collect();
+        assert_eq!(row[row.len() - 1], goldray::grade::flags(s).join("; "), "{}", s.name);
         let points: Vec<f64> = s.images.iter().map(|i| i.points).collect();
         assert_eq!(numbers[..3], points[..], "{}", s.name);
         assert_eq!(numbers[3], s.total);

@@ -14,11 +14,11 @@ use std::time::Duration;
 use goldray::case::{Case, LoadOptions, parse};
 use goldray::options::{Filter, Precision};
 use goldray::progress::Silent;
-use util::{goldray, shipped, stderr};
 use goldray::tradeoff::{
     CSV_COLUMNS, CSV_FILE, MARKDOWN_FILE, Metric, PLOT_FILE, PLOT_HEIGHT, PLOT_WIDTH, SweepPlan, Tradeoff,
     TradeoffOptions, measure_tradeoff, pareto_front, run_tradeoff,
 };
+use util::{goldray, shipped, stderr};
 
 fn case(toml: &str) -> Case {
     parse(toml, Path::new("tradeoff_test.toml"), &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"))
@@ -279,7 +279,6 @@ fn tiny_options(out: &Path) -> TradeoffOptions {
     }
 }
 
-
 #[test]
 fn the_report_reads_back_with_every_setting_and_the_plot_decodes() {
     let dir = tempfile::tempdir().unwrap();
@@ -383,7 +382,6 @@ fn the_target_is_the_fastest_setting_that_meets_it_or_a_clear_no() {
     let sentence = none.target_sentence().unwrap();
     assert!(sentence.starts_with("no setting reached FLIP mean ≤ 0;"), "{sentence}");
 }
-
 
 const QUICK: [&str; 12] = [
     "--size",
