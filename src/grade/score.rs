@@ -164,10 +164,16 @@ pub fn grade_image(
         result.fingerprint = (!copy_of_published).then(|| Fingerprint::of(&picture, true));
         return Ok(refused(result, outcome));
     };
+    let (outcome, mut explanation) = judge(&spec.rule, &metrics);
     if metrics.worst.is_none() {
         // Identical: the golden picture stands in for the student's, and there is no difference
         // to draw, which keeps the report of a good class small.
         result.student_image = Some(format!("{GOLDEN_DIR}/{}", spec.file));
+    } else if outcome == Outcome::Pass {
+        // Full points: a thumbnail shows what was handed in; there is nothing for the student to
+        // find in a full-size copy or a heatmap, and a class that passes keeps a small report.
+        write_file_atomic(&out.join(&copy), &encode_png(&thumbnail(&actual.preview))?)?;
+        result.student_image = Some(copy);
     } else {
         write_file_atomic(&out.join(&copy), &encode_png(&actual.preview)?)?;
         result.student_image = Some(copy);
@@ -178,7 +184,6 @@ pub fn grade_image(
             result.diff_image = Some(diff);
         }
     }
-    let (outcome, mut explanation) = judge(&spec.rule, &metrics);
     result.points = match outcome {
         Outcome::Pass => spec.points,
         Outcome::Partial => spec.points * spec.rule.partial_credit,
@@ -199,6 +204,21 @@ pub fn grade_image(
     result.explanation = explanation;
     result.metrics = Some(metrics);
     Ok(result)
+}
+
+/// The side of the square a passing picture's thumbnail fits in: the report shows pictures 300
+/// pixels wide.
+const THUMBNAIL: u32 = 300;
+
+/// `picture` shrunk (never enlarged) to fit a [`THUMBNAIL`] square, keeping its aspect.
+fn thumbnail(picture: &image::RgbImage) -> image::RgbImage {
+    let (width, height) = picture.dimensions();
+    let longest = width.max(height);
+    if longest <= THUMBNAIL {
+        return picture.clone();
+    }
+    let scale = |side: u32| ((u64::from(side) * u64::from(THUMBNAIL)) / u64::from(longest)).max(1) as u32;
+    image::imageops::thumbnail(picture, scale(width), scale(height))
 }
 
 /// A result with nothing compared: no points, and the outcome's reason as the explanation.
