@@ -166,6 +166,8 @@ fn equal_fraction(a: &RgbImage, b: &RgbImage) -> f64 {
 
 #[cfg(test)]
 mod tests {
+    use std::path::PathBuf;
+
     use super::*;
     use image::Rgb;
 
@@ -177,38 +179,20 @@ mod tests {
         picture
     }
 
-    #[test]
-    fn identical_and_near_identical_pictures_pair_and_different_ones_do_not() {
+    /// Saves each student's picture of `a01.png` and pairs them, as grading would.
+    fn pairs_of(students: &[(&str, RgbImage)]) -> Vec<SimilarPair> {
         let dir = tempfile::tempdir().unwrap();
-        // One changed pixel in 10,000 is at the 99.99% line: not near-identical. None is identical.
-        let pictures = [
-            ("ann", picture(1, 0)),
-            ("ben", picture(1, 0)),
-            ("cat", picture(2, 0)),
-            ("dan", picture(3, 0)),
-            ("eve", picture(3, 0)),
-            ("fay", picture(4, 0)),
-        ];
-        let mut paths = Vec::new();
-        for (name, picture) in &pictures {
-            let path = dir.path().join(format!("{name}.png"));
-            picture.save(&path).unwrap();
-            paths.push(path);
-        }
-        // dan and eve differ on no pixel: identical; make eve's differ on one pixel of 10,000 so
-        // that she is only near-identical (99.99% equal is not more than 99.99%: not listed).
-        let mut eve = pictures[4].1.clone();
-        eve.put_pixel(50, 50, Rgb([1, 2, 3]));
-        eve.save(&paths[4]).unwrap();
-        let fingerprints: Vec<Fingerprint> = paths
+        let saved: Vec<(&str, PathBuf, Fingerprint)> = students
             .iter()
-            .map(|p| Fingerprint::of(&read_png(p).unwrap().picture, true))
+            .map(|(name, picture)| {
+                let path = dir.path().join(format!("{name}.png"));
+                picture.save(&path).unwrap();
+                (*name, path, Fingerprint::of(picture, true))
+            })
             .collect();
-        let entries: Vec<Entry> = pictures
+        let entries: Vec<Entry> = saved
             .iter()
-            .zip(&paths)
-            .zip(&fingerprints)
-            .map(|(((name, _), path), fingerprint)| Entry {
+            .map(|(name, path, fingerprint)| Entry {
                 student: name,
                 file: "a01.png",
                 order: 0,
@@ -216,7 +200,22 @@ mod tests {
                 fingerprint,
             })
             .collect();
-        let pairs = similar_pairs(&entries);
+        similar_pairs(&entries)
+    }
+
+    #[test]
+    fn identical_pictures_pair_and_different_ones_do_not() {
+        // eve differs from dan on one pixel of 10,000: 99.99% equal is not more than 99.99%.
+        let mut eve = picture(3, 0);
+        eve.put_pixel(50, 50, Rgb([1, 2, 3]));
+        let pairs = pairs_of(&[
+            ("ann", picture(1, 0)),
+            ("ben", picture(1, 0)),
+            ("cat", picture(2, 0)),
+            ("dan", picture(3, 0)),
+            ("eve", eve),
+            ("fay", picture(4, 0)),
+        ]);
         assert_eq!(
             pairs,
             [SimilarPair {
@@ -228,7 +227,6 @@ mod tests {
 
     #[test]
     fn near_identical_failing_pictures_pair_through_their_samples() {
-        let dir = tempfile::tempdir().unwrap();
         let big = |changed: u32| {
             let mut p = RgbImage::from_fn(400, 400, |x, y| Rgb([(x % 256) as u8, (y % 256) as u8, 7]));
             for i in 0..changed {
@@ -237,24 +235,7 @@ mod tests {
             p
         };
         // 160,000 pixels: 5 changed is 99.997% equal (near-identical), 400 changed is 99.75%.
-        let cases = [("ann", big(0)), ("ben", big(5)), ("cat", big(400))];
-        let mut entries_data = Vec::new();
-        for (name, picture) in &cases {
-            let path = dir.path().join(format!("{name}.png"));
-            picture.save(&path).unwrap();
-            entries_data.push((*name, path, Fingerprint::of(picture, true)));
-        }
-        let entries: Vec<Entry> = entries_data
-            .iter()
-            .map(|(name, path, fingerprint)| Entry {
-                student: name,
-                file: "a01.png",
-                order: 0,
-                path,
-                fingerprint,
-            })
-            .collect();
-        let pairs = similar_pairs(&entries);
+        let pairs = pairs_of(&[("ann", big(0)), ("ben", big(5)), ("cat", big(400))]);
         assert_eq!(pairs.len(), 1, "{pairs:?}");
         assert_eq!(pairs[0].students, ["ann".to_owned(), "ben".to_owned()]);
     }
