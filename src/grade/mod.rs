@@ -23,10 +23,12 @@
 mod error;
 mod golden;
 mod html;
+mod integrity;
 mod outcome;
 mod report;
 mod rubric;
 mod score;
+mod similarity;
 mod submission;
 
 use std::collections::BTreeMap;
@@ -39,10 +41,13 @@ use rayon::prelude::*;
 use crate::progress::Progress;
 pub use error::{GradeError, RubricError};
 pub use golden::{GoldenRender, Goldens, default_cache_dir, prepare_goldens};
+pub use integrity::{Integrity, LinkPolicy, PUBLISHED_COPY};
 pub use outcome::Outcome;
-pub use report::{ClassReport, RubricSummary};
+pub use report::{ClassReport, RubricSummary, flags};
 pub use rubric::{ImageSpec, Output, RenderSource, Rubric, Rule, load_rubric, parse_rubric};
 pub use score::{ImageResult, StudentResult, Submission, grade_image, judge};
+use similarity::similar_pairs;
+pub use similarity::{NEAR_IDENTICAL, SimilarPair};
 
 /// Where the report and the golden cache go.
 #[derive(Clone, Debug)]
@@ -79,6 +84,7 @@ pub fn grade_class(
     // One task per image rather than per student, so that both cores stay busy to the end of a
     // small class.
     let per_student = rubric.images.len();
+    let published = integrity::published_hashes(&rubric.integrity, &rubric.images);
     progress.begin("grading", (folders.len() * per_student) as u64);
     // Images left per student, so that the last one to finish can say the student is done.
     let left: Vec<AtomicUsize> = folders.iter().map(|_| AtomicUsize::new(per_student)).collect();
@@ -86,7 +92,15 @@ pub fn grade_class(
         .into_par_iter()
         .map(|task| {
             let (student, image) = (task / per_student, task % per_student);
-            let result = grade_image(&rubric.images[image], &goldens.images[image], &folders[student], out);
+            let spec = &rubric.images[image];
+            let result = grade_image(
+                spec,
+                &goldens.images[image],
+                &folders[student],
+                &rubric.integrity,
+                published.get(&spec.file).copied(),
+                out,
+            );
             progress.advance(1);
             if left[student].fetch_sub(1, Ordering::Relaxed) == 1 {
                 progress.done(&folders[student].name);
@@ -96,10 +110,26 @@ pub fn grade_class(
         .collect::<Result<Vec<_>, _>>()?;
     progress.finish();
     let mut results = results.into_iter();
-    let students = folders
+    let students: Vec<StudentResult> = folders
         .iter()
         .map(|submission| StudentResult::new(submission, results.by_ref().take(per_student).collect()))
         .collect();
+    let similar = similar_pairs(
+        &students
+            .iter()
+            .flat_map(|student| {
+                student.images.iter().enumerate().filter_map(|(order, image)| {
+                    Some(similarity::Entry {
+                        student: &student.name,
+                        file: &image.file,
+                        order,
+                        path: image.graded_file.as_deref()?,
+                        fingerprint: image.fingerprint.as_ref()?,
+                    })
+                })
+            })
+            .collect::<Vec<_>>(),
+    );
 
     let report = ClassReport {
         goldray: env!("CARGO_PKG_VERSION"),
@@ -109,6 +139,7 @@ pub fn grade_class(
         goldens: goldens.renders,
         ignored,
         students,
+        similar,
     };
     report::write_data(&report, out)?;
     html::write_html(&report, out)?;
