@@ -20,7 +20,7 @@ use std::path::Path;
 pub use crate::located_toml::SourceLocation;
 pub use assignment::{AssignmentOptions, load_assignment_scene, parse_assignment_scene};
 pub use error::CaseError;
-pub use export::case_to_toml;
+pub use export::{case_to_toml, case_to_toml_anywhere};
 pub use sections::MAX_BOUNCES;
 pub use spec::{
     BackgroundSpec, CameraSpec, Case, LightSpec, MaterialSpec, ObjectSpec, RenderSettings, ShapeSpec, TransformOp,

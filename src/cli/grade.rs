@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use goldray::grade::{GradeOptions, grade_class, summary};
+use goldray::grade::{Diagnose, GradeOptions, grade_class_diagnosing, summary};
 
 use super::Failure;
 use super::common::ThreadFlags;
@@ -38,12 +38,12 @@ pub fn run(args: GradeArgs) -> Result<ExitCode, Failure> {
     let options = GradeOptions {
         out: args.out.clone(),
         cache: args.cache.clone(),
-        diagnose: !args.no_diagnose,
     };
     let reporter = Reporter::new(args.quiet);
+    let diagnose = if args.no_diagnose { Diagnose::No } else { Diagnose::Yes };
     let report = args
         .threads
-        .install(|| grade_class(&args.rubric, &args.submissions, &options, &reporter))??;
+        .install(|| grade_class_diagnosing(&args.rubric, &args.submissions, &options, diagnose, &reporter))??;
     if !args.quiet {
         println!("{}", summary(&report, &args.out));
     }

@@ -11,7 +11,7 @@
 //! use goldray::grade::{GradeOptions, grade_class};
 //! # fn main() -> Result<(), goldray::grade::GradeError> {
 //! use goldray::progress::Silent;
-//! let options = GradeOptions::new("report");
+//! let options = GradeOptions { out: "report".into(), cache: None };
 //! let report = grade_class("rubrics/mit6837.toml".as_ref(), "submissions".as_ref(), &options, &Silent)?;
 //! for student in &report.students {
 //!     println!("{}: {} / {}", student.name, student.total, student.max_points);
@@ -24,10 +24,12 @@ mod diagnose;
 mod error;
 mod golden;
 mod html;
+mod integrity;
 mod outcome;
 mod report;
 mod rubric;
 mod score;
+mod similarity;
 mod submission;
 
 use std::collections::BTreeMap;
@@ -44,40 +46,49 @@ pub use diagnose::{
 };
 pub use error::{GradeError, RubricError};
 pub use golden::{GoldenRender, Goldens, default_cache_dir, prepare_goldens};
+pub use integrity::{Integrity, LinkPolicy, PUBLISHED_COPY};
 pub use outcome::Outcome;
-pub use report::{ClassReport, RubricSummary};
+pub use report::{ClassReport, RubricSummary, flags};
 pub use rubric::{ImageSpec, Output, RenderSource, Rubric, Rule, load_rubric, parse_rubric};
 pub use score::{ImageResult, StudentResult, Submission, grade_image, judge};
+use similarity::similar_pairs;
+pub use similarity::{NEAR_IDENTICAL, SimilarPair};
 
-/// Where the report and the golden cache go, and whether to diagnose.
+/// Where the report and the golden cache go.
 #[derive(Clone, Debug)]
 pub struct GradeOptions {
     pub out: PathBuf,
     /// `None`: [`default_cache_dir`].
     pub cache: Option<PathBuf>,
-    /// Name the mistake behind each image that lost points (see [`Diagnosis`]).
-    pub diagnose: bool,
 }
 
-impl GradeOptions {
-    /// A report in `out`, the default cache, with diagnosis.
-    pub fn new(out: impl Into<PathBuf>) -> GradeOptions {
-        GradeOptions {
-            out: out.into(),
-            cache: None,
-            diagnose: true,
-        }
-    }
+/// Whether grading names the mistake behind each image that lost points (see [`Diagnosis`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Diagnose {
+    Yes,
+    No,
 }
 
 /// Loads the rubric, prepares the goldens, grades every student folder of `submissions` on the
-/// current rayon pool and writes the whole report. Golden renders, then graded students, are
-/// reported to `progress`. Returns an error only when grading could not run; what students
-/// handed in never makes it fail.
+/// current rayon pool, diagnoses the images that lost points and writes the whole report.
+/// Golden renders, then graded students, then diagnosed images are reported to `progress`.
+/// Returns an error only when grading could not run; what students handed in never makes it
+/// fail.
 pub fn grade_class(
     rubric_path: &Path,
     submissions: &Path,
     options: &GradeOptions,
+    progress: &dyn Progress,
+) -> Result<ClassReport, GradeError> {
+    grade_class_diagnosing(rubric_path, submissions, options, Diagnose::Yes, progress)
+}
+
+/// [`grade_class`], diagnosing or not.
+pub fn grade_class_diagnosing(
+    rubric_path: &Path,
+    submissions: &Path,
+    options: &GradeOptions,
+    diagnose: Diagnose,
     progress: &dyn Progress,
 ) -> Result<ClassReport, GradeError> {
     let rubric = load_rubric(rubric_path)?;
@@ -97,6 +108,7 @@ pub fn grade_class(
     // One task per image rather than per student, so that both cores stay busy to the end of a
     // small class.
     let per_student = rubric.images.len();
+    let published = integrity::published_hashes(&rubric.integrity, &rubric.images);
     progress.begin("grading", (folders.len() * per_student) as u64);
     // Images left per student, so that the last one to finish can say the student is done.
     let left: Vec<AtomicUsize> = folders.iter().map(|_| AtomicUsize::new(per_student)).collect();
@@ -104,7 +116,15 @@ pub fn grade_class(
         .into_par_iter()
         .map(|task| {
             let (student, image) = (task / per_student, task % per_student);
-            let result = grade_image(&rubric.images[image], &goldens.images[image], &folders[student], out);
+            let spec = &rubric.images[image];
+            let result = grade_image(
+                spec,
+                &goldens.images[image],
+                &folders[student],
+                &rubric.integrity,
+                published.get(&spec.file).copied(),
+                out,
+            );
             progress.advance(1);
             if left[student].fetch_sub(1, Ordering::Relaxed) == 1 {
                 progress.done(&folders[student].name);
@@ -118,7 +138,7 @@ pub fn grade_class(
         .iter()
         .map(|submission| StudentResult::new(submission, results.by_ref().take(per_student).collect()))
         .collect();
-    let diagnosis = if options.diagnose {
+    let diagnosis = if diagnose == Diagnose::Yes {
         Some(diagnose::diagnose_class(
             &rubric,
             &goldens,
@@ -130,6 +150,22 @@ pub fn grade_class(
     } else {
         None
     };
+    let similar = similar_pairs(
+        &students
+            .iter()
+            .flat_map(|student| {
+                student.images.iter().enumerate().filter_map(|(order, image)| {
+                    Some(similarity::Entry {
+                        student: &student.name,
+                        file: &image.file,
+                        order,
+                        path: image.graded_file.as_deref()?,
+                        fingerprint: image.fingerprint.as_ref()?,
+                    })
+                })
+            })
+            .collect::<Vec<_>>(),
+    );
 
     let report = ClassReport {
         goldray: env!("CARGO_PKG_VERSION"),
@@ -140,6 +176,7 @@ pub fn grade_class(
         diagnosis,
         ignored,
         students,
+        similar,
     };
     report::write_data(&report, out)?;
     html::write_html(&report, out)?;

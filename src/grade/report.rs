@@ -10,6 +10,7 @@ use super::diagnose::DiagnosisRun;
 use super::golden::GoldenRender;
 use super::rubric::{ImageSpec, Rubric};
 use super::score::StudentResult;
+use super::similarity::SimilarPair;
 use crate::atomic_write::write_file_atomic;
 use crate::film::OutputError;
 
@@ -29,6 +30,8 @@ pub struct ClassReport {
     pub ignored: Vec<String>,
     /// By folder name.
     pub students: Vec<StudentResult>,
+    /// Pairs of students who handed in the same picture, or nearly the same failing one.
+    pub similar: Vec<SimilarPair>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -60,12 +63,13 @@ pub fn write_data(report: &ClassReport, out: &Path) -> Result<(), OutputError> {
     Ok(())
 }
 
-/// One row per student: the folder name, the points of each image in rubric order, the total.
+/// One row per student: the folder name, the points of each image in rubric order, the total,
+/// and the flags on the student's images (`a01.png: identical to the published reference; …`).
 pub fn grades_csv(report: &ClassReport) -> String {
     let mut csv = String::new();
     let header = std::iter::once("student")
         .chain(report.rubric.images.iter().map(|i| i.file.as_str()))
-        .chain(["total"])
+        .chain(["total", "flags"])
         .map(csv_field)
         .collect::<Vec<_>>();
     csv.push_str(&header.join(","));
@@ -73,12 +77,21 @@ pub fn grades_csv(report: &ClassReport) -> String {
     for student in &report.students {
         let row = std::iter::once(csv_field(&student.name))
             .chain(student.images.iter().map(|i| format_points(i.points)))
-            .chain([format_points(student.total)])
+            .chain([format_points(student.total), csv_field(&flags(student).join("; "))])
             .collect::<Vec<_>>();
         csv.push_str(&row.join(","));
         csv.push_str("\r\n");
     }
     csv
+}
+
+/// Each flag of a student's images, as `FILE: flag`.
+pub fn flags(student: &StudentResult) -> Vec<String> {
+    student
+        .images
+        .iter()
+        .flat_map(|image| image.flags.iter().map(move |flag| format!("{}: {flag}", image.file)))
+        .collect()
 }
 
 /// RFC 4180 quoting, and a leading `'` on anything a spreadsheet would run as a formula: folder

@@ -9,6 +9,7 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use super::error::RubricError;
+use super::integrity::{Integrity, integrity};
 use crate::case::{self, AssignmentOptions, Case, LoadOptions, MAX_BOUNCES, load_assignment_scene};
 use crate::image_size::{MAX_IMAGE_SIZE, SizeLimit, check_side};
 use crate::located_toml::{self, Doc, Field, SourceLocation, Table, suggest};
@@ -23,6 +24,8 @@ pub struct Rubric {
     pub renders: Vec<RenderSource>,
     /// In file order, which is the column order of every report.
     pub images: Vec<ImageSpec>,
+    /// What grading checks about where submitted files come from.
+    pub integrity: Integrity,
 }
 
 /// One `[render.NAME]`: a render that one or more images are taken from.
@@ -95,7 +98,7 @@ const DEFAULT_RULE: Rule = Rule {
 };
 const DEFAULT_POINTS: f64 = 1.0;
 
-const TOP_KEYS: &[&str] = &["title", "defaults", "render", "image"];
+const TOP_KEYS: &[&str] = &["title", "defaults", "render", "image", "integrity"];
 const RULE_KEYS: &[&str] = &[
     "threshold",
     "pass_fraction",
@@ -158,6 +161,10 @@ pub fn parse_rubric(source: &str, path: &Path) -> Result<Rubric> {
             images.push(image_spec(&entry, &renders, &base_rule, base_points)?);
         }
     }
+    let integrity = match top.get("integrity") {
+        Some(field) => integrity(&field.table("[integrity]".to_owned())?)?,
+        None => Integrity::default(),
+    };
     if images.is_empty() {
         return Err(RubricError::Missing {
             file: path.to_path_buf(),
@@ -172,6 +179,7 @@ pub fn parse_rubric(source: &str, path: &Path) -> Result<Rubric> {
         }),
         renders,
         images,
+        integrity,
     })
 }
 

@@ -56,15 +56,19 @@ impl<'a, F: FaultPolicy> Whitted<'a, F> {
                 break;
             }
             color += throughput * self.direct_light(&ray, &hit, rays);
-            let reflects = material.reflects() || self.faults.has(Fault::ReflectionOnEveryMaterial);
-            if depth == self.bounces || !reflects {
+            let mirror = match self.spawn {
+                // Compared as the course does: its float length widened to double, against 0.1.
+                Spawn::Course => (material.specular.length() as f64) > Spawn::COURSE_MIRROR_THRESHOLD,
+                _ => material.reflects(),
+            };
+            if depth == self.bounces || !(mirror || self.faults.has(Fault::ReflectionOnEveryMaterial)) {
                 break;
             }
             if !self.faults.has(Fault::ReflectionWithoutKs) {
                 throughput *= material.specular;
             }
             let normal = hit.surface.shading_normal;
-            let incoming = ray.direction.normalize();
+            let incoming = self.view(ray.direction);
             let reflected = incoming - 2.0 * incoming.dot(normal) * normal;
             ray = spawn(self.spawn, &hit.surface, reflected);
             if self.faults.has(Fault::ReflectionAcne) {
@@ -80,7 +84,7 @@ impl<'a, F: FaultPolicy> Whitted<'a, F> {
         let scene = self.scene;
         let material = &scene.materials[hit.material as usize];
         let surface = &hit.surface;
-        let to_eye = -ray.direction.normalize();
+        let to_eye = -self.view(ray.direction);
         let mut color = scene.ambient * material.diffuse;
         let mut lit = false;
         for light in &scene.lights {
@@ -104,6 +108,16 @@ impl<'a, F: FaultPolicy> Whitted<'a, F> {
             return Color::ZERO;
         }
         color
+    }
+
+    /// The direction a ray travels in, for reflecting and for the highlight: unit length, except
+    /// that the course uses it as computed (longer or shorter after one of its planes with a
+    /// non-unit normal).
+    fn view(&self, direction: Vec3) -> Vec3 {
+        match self.spawn {
+            Spawn::Course => direction,
+            _ => direction.normalize(),
+        }
     }
 
     fn blocked(&self, hit: &Intersection, to_light: Vec3, position: Option<Vec3>) -> bool {

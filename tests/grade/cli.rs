@@ -17,7 +17,6 @@ fn goldens_are_rendered_once_then_read_from_the_cache() {
         let options = GradeOptions {
             out: class.dir.join(out),
             cache: Some(cache.clone()),
-            diagnose: true,
         };
         grade_class(&class.rubric, &class.submissions, &options, &Silent).unwrap_or_else(|e| panic!("{e}"))
     };

@@ -3,11 +3,10 @@
 //! A course `Transform { ops… object }` wraps one object; here it becomes that object with the
 //! ops in front of its own, which is the same matrix because the outer transform is applied last.
 
-use super::Parser;
 use super::lexer::{Result, Token};
+use super::{Parser, usable_in_single_precision};
 use crate::case::objects::{file_problem, singularity};
 use crate::case::spec::{ObjectSpec, ShapeSpec, TransformOp};
-use crate::case::value::has_usable_length;
 
 const GROUP_WORDS: &[&str] = &[
     "Group",
@@ -63,22 +62,22 @@ impl<'a> Parser<'a> {
         Ok(objects)
     }
 
-    /// `MaterialIndex k` names the k-th material of the latest Materials block, as in the course.
+    /// `MaterialIndex k` names the k-th material read so far, counting every Materials block,
+    /// and must be below the latest block's `numMaterials`: the course asserts exactly that.
     fn material_index(&mut self) -> Result<()> {
         let (k, token) = self.lex.count("MaterialIndex")?;
-        let block = self.block_materials.clone();
-        if k < block.len() {
-            self.current_material = Some(block.start + k);
+        if k < self.material_count {
+            self.current_material = Some(k);
             return Ok(());
         }
-        let message = match block.len() {
+        let message = match self.material_count {
             0 => format!(
                 "`MaterialIndex {k}` refers to no material: no materials are defined before it \
-                 (a Materials block must come before the Group)"
+                 (a Materials block with numMaterials ≥ 1 must come before the Group)"
             ),
             n => format!(
-                "`MaterialIndex {k}` is out of range: numMaterials is {n}, so indices go from 0 \
-                 to {}",
+                "`MaterialIndex {k}` is out of range: the latest Materials block has numMaterials \
+                 {n}, so indices go from 0 to {}",
                 n - 1
             ),
         };
@@ -101,7 +100,19 @@ impl<'a> Parser<'a> {
         };
         let material = match shape {
             ShapeSpec::Group { .. } => None,
-            _ => self.current_material,
+            // The course asserts a material for a sphere, plane or triangle, and dereferences
+            // a mesh's null material as soon as a ray hits the mesh.
+            _ => match self.current_material {
+                Some(material) => Some(material),
+                None => {
+                    let message = format!(
+                        "this {} has no material: put `MaterialIndex k` before it (the course \
+                         stops on a shape without one)",
+                        token.text
+                    );
+                    return Err(self.lex.error_at(token.start, message));
+                }
+            },
         };
         Ok(ObjectSpec {
             shape,
@@ -127,12 +138,14 @@ impl<'a> Parser<'a> {
         self.lex.expect("center", "first in Sphere")?;
         let center = self.lex.vec3("3 numbers after `center`")?.value;
         self.lex.expect("radius", "after the sphere's center")?;
-        let (radius, token) = self.lex.number("a number after `radius`")?;
-        if radius < 0.0 {
-            return Err(self.invalid(token, "`radius`", "must be ≥ 0"));
-        }
+        let (radius, _) = self.lex.number("a number after `radius`")?;
         self.lex.expect("}", "closing Sphere")?;
-        Ok(ShapeSpec::Sphere { center, radius })
+        // The course's sphere test uses only r² and normalises `p − center`, so a negative
+        // radius draws the sphere of radius |r|, normals and all.
+        Ok(ShapeSpec::Sphere {
+            center,
+            radius: radius.abs(),
+        })
     }
 
     fn plane(&mut self) -> Result<ShapeSpec> {
@@ -171,6 +184,10 @@ impl<'a> Parser<'a> {
         self.lex.expect("{", "after `TriangleMesh`")?;
         self.lex.expect("obj_file", "first in TriangleMesh")?;
         let written = self.lex.word_for("a file name after `obj_file`")?;
+        if !written.text.ends_with(".obj") {
+            let rule = "must name a file ending in `.obj` (the course asserts that extension)";
+            return Err(self.invalid(written, "`obj_file`", rule));
+        }
         let obj = self.dir.join(written.text);
         if let Some(problem) = file_problem(&obj) {
             let message = format!("`obj_file {}` resolves to {}, {problem}", written.text, obj.display());
@@ -231,7 +248,7 @@ impl<'a> Parser<'a> {
     fn rotate(&mut self) -> Result<TransformOp> {
         self.lex.expect("{", "after `Rotate`")?;
         let axis = self.lex.vec3("3 numbers (the axis) after `Rotate {`")?;
-        if !has_usable_length(axis.value) {
+        if !usable_in_single_precision(axis.value) {
             let rule = "must have a nonzero, finite length";
             return Err(self.invalid_vec(&axis, "the rotation axis", rule));
         }
