@@ -8,6 +8,11 @@
 //! program differs from goldray (a camera moved by a fraction of a pixel, ±1-code noise), so
 //! that the rule is not tuned to goldray's own renders alone.
 
+// Shared with tests/grade.rs, which uses all of it.
+#[allow(dead_code)]
+#[path = "grade/chromium.rs"]
+mod chromium;
+
 use std::collections::BTreeMap;
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -151,6 +156,7 @@ const PAIRS: [&str; 5] = [
 ];
 
 struct Graded {
+    dir: PathBuf,
     report: ClassReport,
     /// Each student's fault set (`none` for the correct ones).
     made: BTreeMap<String, FaultSet>,
@@ -193,6 +199,7 @@ fn grade(name: &str, perturbation: Perturbation) -> Graded {
     let started = Instant::now();
     let report = grade_class(&rubric_path, &submissions, &options, &Silent).unwrap_or_else(|e| panic!("{e}"));
     Graded {
+        dir,
         report,
         made,
         seconds: started.elapsed().as_secs_f64(),
@@ -425,4 +432,143 @@ fn an_independent_programs_mistakes_are_diagnosed_too() {
         tally.wrong
     );
     assert!(accuracy >= 0.9, "{accuracy}");
+}
+
+#[test]
+fn grades_json_has_a_diagnosis_exactly_where_points_were_lost() {
+    let graded = exact();
+    let json: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(graded.dir.join("report/grades.json")).unwrap()).unwrap();
+    let mut diagnosed = 0;
+    for student in json["students"].as_array().unwrap() {
+        for image in student["images"].as_array().unwrap() {
+            let lost = matches!(image["verdict"].as_str(), Some("partial" | "fail"));
+            let diagnosis = &image["diagnosis"];
+            assert_eq!(!diagnosis.is_null(), lost, "{} {}", student["name"], image["file"]);
+            if lost {
+                diagnosed += 1;
+                for key in ["id", "explanation", "confidence", "golden", "explained"] {
+                    assert!(!diagnosis[key].is_null(), "{key} in {diagnosis}");
+                }
+                if diagnosis["id"] != UNEXPLAINED {
+                    assert!(diagnosis["residual"]["failing_fraction"].is_number(), "{diagnosis}");
+                    assert!(diagnosis["residual_metrics"]["flip"].is_number(), "{diagnosis}");
+                    assert!(diagnosis["mistake_image"].is_string(), "{diagnosis}");
+                }
+            }
+        }
+    }
+    assert!(diagnosed > 250);
+    assert!(json["diagnosis"]["renders"].as_array().unwrap().len() == 7);
+    let csv = fs::read_to_string(graded.dir.join("report/grades.csv")).unwrap();
+    assert!(csv.lines().next().unwrap().ends_with(",flags,diagnoses"), "{csv}");
+    assert!(
+        csv.lines()
+            .any(|l| l.starts_with("no-shadows,") && l.ends_with(",no-shadows")),
+        "{csv}"
+    );
+}
+
+#[test]
+fn the_report_shows_the_mistakes_in_headless_chromium() {
+    let graded = exact();
+    let out = graded.dir.join("report");
+    let dom = chromium::dump_dom(&out.join("index.html"));
+    assert!(dom.contains("data-images-broken=\"0\""), "a picture did not load");
+    assert!(dom.contains("<h2>Mistakes in the class</h2>"));
+    for id in ["no-shadows", "gamma-applied", "nothing-shaded", "pixel-mapping"] {
+        assert!(
+            dom.contains(&format!("data-mistake=\"{id}\"")),
+            "{id} is not in the histogram"
+        );
+    }
+    let page = out.join(&student(graded, "no-shadows + gamma-applied=srgb").page);
+    let dom = chromium::dump_dom(&page);
+    assert!(
+        dom.contains("data-images-broken=\"0\""),
+        "a picture did not load:\n{dom}"
+    );
+    let leads = dom
+        .find("<h2>What went wrong</h2>")
+        .expect("the page leads with the mistakes");
+    let first_image = dom.find("<section class=\"image").unwrap();
+    assert!(leads < first_image, "the mistakes come before the images");
+    for needle in [
+        "data-mistake=\"no-shadows\"",
+        "data-mistake=\"gamma-applied\"",
+        "Explains <a href=\"#a07.png\">a07.png</a>.",
+        "the mistake's render",
+        "together with <code class=\"id\">gamma-applied</code>",
+    ] {
+        assert!(dom.contains(needle), "{needle}");
+    }
+    let shot = chromium::screenshot(&page, 1200, 1000, &out.join("mistakes.png"));
+    let colours: std::collections::HashSet<[u8; 3]> = shot.pixels().map(|p| p.0).collect();
+    assert!(
+        colours.len() > 500,
+        "the screenshot looks blank: {} colours",
+        colours.len()
+    );
+    chromium::screenshot(&out.join("index.html"), 1200, 1400, &out.join("index.png"));
+}
+
+#[test]
+fn a_rubric_can_grant_credit_per_mistake() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("diagnose-credit");
+    if dir.exists() {
+        fs::remove_dir_all(&dir).unwrap();
+    }
+    let plain = course_rubric(&dir);
+    let rubric = load_rubric(&plain).unwrap();
+    let renderers = renderers(&rubric, Perturbation::None);
+    let submissions = dir.join("submissions");
+    write_student(
+        &rubric,
+        &renderers,
+        &"no-shadows".parse().unwrap(),
+        Perturbation::None,
+        &submissions.join("s"),
+    );
+    let credited = dir.join("credited.toml");
+    let text = fs::read_to_string(&plain).unwrap();
+    fs::write(&credited, format!("{text}\n[mistake.\"no-shadows\"]\ncredit = 0.75\n")).unwrap();
+    let cache = Some(Path::new(env!("CARGO_TARGET_TMPDIR")).join("diagnose-cache"));
+    let grade = |rubric: &Path, out: &str| {
+        let options = GradeOptions {
+            out: dir.join(out),
+            cache: cache.clone(),
+        };
+        grade_class(rubric, &submissions, &options, &Silent).unwrap()
+    };
+    let without = grade(&plain, "plain");
+    let with = grade(&credited, "credited");
+    let a07 = |r: &ClassReport| r.students[0].images[18].clone();
+    assert_eq!(a07(&without).points, 0.0, "{}", a07(&without).explanation);
+    assert_eq!(a07(&with).points, 1.5, "{}", a07(&with).explanation);
+    assert_eq!(a07(&with).diagnosis.unwrap().credit, Some(0.75));
+    assert!(
+        a07(&with)
+            .explanation
+            .contains("75% of the points for the diagnosed mistake no-shadows")
+    );
+    assert_eq!(with.students[0].total, without.students[0].total + 1.5);
+    // The other images are as they were.
+    for (a, b) in with.students[0]
+        .images
+        .iter()
+        .zip(&without.students[0].images)
+        .filter(|(a, _)| a.file != "a07.png")
+    {
+        assert_eq!(a.points, b.points, "{}", a.file);
+    }
+
+    fs::write(&credited, format!("{text}\n[mistake.\"no-shadow\"]\ncredit = 0.75\n")).unwrap();
+    let error = load_rubric(&credited).unwrap_err().to_string();
+    assert!(
+        error.contains("not a mistake of the catalogue") && error.contains("did you mean `no-shadows`"),
+        "{error}"
+    );
+    fs::write(&credited, format!("{text}\n[mistake.\"no-shadows\"]\ncredit = 2\n")).unwrap();
+    let error = load_rubric(&credited).unwrap_err().to_string();
+    assert!(error.contains("between 0 and 1"), "{error}");
 }

@@ -48,7 +48,7 @@ pub use error::{GradeError, RubricError};
 pub use golden::{GoldenRender, Goldens, default_cache_dir, prepare_goldens};
 pub use integrity::{Integrity, LinkPolicy, PUBLISHED_COPY};
 pub use outcome::Outcome;
-pub use report::{ClassReport, RubricSummary, flags};
+pub use report::{ClassReport, RubricSummary, diagnoses_of, flags, mistakes_of};
 pub use rubric::{ImageSpec, Output, RenderSource, Rubric, Rule, load_rubric, parse_rubric};
 pub use score::{ImageResult, StudentResult, Submission, grade_image, judge};
 use similarity::similar_pairs;
@@ -139,14 +139,10 @@ pub fn grade_class_diagnosing(
         .map(|submission| StudentResult::new(submission, results.by_ref().take(per_student).collect()))
         .collect();
     let diagnosis = if diagnose == Diagnose::Yes {
-        Some(diagnose::diagnose_class(
-            &rubric,
-            &goldens,
-            &cache,
-            &mut students,
-            out,
-            progress,
-        )?)
+        let run = diagnose::diagnose_class(&rubric, &goldens, &cache, &mut students, out, progress)?;
+        diagnose::prefer_consistent(&mut students);
+        diagnose::apply_credit(&rubric, &mut students);
+        Some(run)
     } else {
         None
     };
