@@ -14,6 +14,9 @@
 //! `build` is the whole of `Mesh::new` (validation, vertex normals, the BVH, the triangle
 //! storage), what goldray does before a mesh can be traced. `hit` is the fraction of rays that
 //! hit and `sum_t` the sum of their hit distances, which must agree with Embree's.
+//!
+//! `RAYBENCH_PASSES=1` traces the rays once instead of three times (for callgrind), and
+//! `GOLDRAY_SIMD` chooses the SIMD path (see `goldray::simd`).
 
 use std::path::Path;
 use std::process::ExitCode;
@@ -86,7 +89,11 @@ fn run(dir: &Path, mesh_name: &str, rays_name: &str, threads: usize) -> Result<S
     let mut t_out = vec![-1.0f32; rays.len()];
     let per_thread = rays.len().div_ceil(threads).next_multiple_of(8).max(8);
     let mut best = f64::INFINITY;
-    for _ in 0..3 {
+    let passes = std::env::var("RAYBENCH_PASSES")
+        .ok()
+        .and_then(|p| p.parse().ok())
+        .unwrap_or(3);
+    for _ in 0..passes {
         let start = Instant::now();
         std::thread::scope(|scope| {
             for (rays, t_out) in rays.chunks(per_thread).zip(t_out.chunks_mut(per_thread)) {

@@ -1,4 +1,4 @@
-//! Binned-SAH construction of a flattened binary BVH, which `collapse` then turns into the 4-wide
+//! Binned-SAH construction of a flattened binary BVH, which `collapse` then turns into the 8-wide
 //! tree that is traversed.
 //!
 //! Every split decision is a pure function of the primitives in the node, and subtrees built in
@@ -22,6 +22,25 @@ const PARALLEL_THRESHOLD: usize = 4096;
 /// Depth after which only median splits are made. SAH splits may peel off one primitive at a
 /// time on adversarial input; median splits guarantee the remaining depth is logarithmic.
 pub(super) const SAH_DEPTH_LIMIT: usize = 32;
+
+/// How the SAH prices a leaf.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LeafCost {
+    /// Each primitive is tested on its own: a leaf of `n` costs `n` tests.
+    PerPrimitive,
+    /// Primitives are tested four at a time (a mesh's triangle packs): a leaf of `n` costs
+    /// `⌈n/4⌉` tests, so leaves fill up to four.
+    PerPackOfFour,
+}
+
+impl LeafCost {
+    fn tests(self, count: usize) -> Real {
+        match self {
+            LeafCost::PerPrimitive => count as Real,
+            LeafCost::PerPackOfFour => count.div_ceil(4) as Real,
+        }
+    }
+}
 
 /// One node of the binary tree. Nodes are stored depth first: an interior node's first child
 /// immediately follows it, so only the second child's index needs storing.
@@ -49,7 +68,7 @@ impl BinaryNode {
 }
 
 /// Returns the nodes in depth-first order and the primitive indices in leaf order.
-pub(super) fn build(bounds: &[Aabb]) -> (Vec<BinaryNode>, Vec<u32>) {
+pub(super) fn build(bounds: &[Aabb], cost: LeafCost) -> (Vec<BinaryNode>, Vec<u32>) {
     assert!(
         u32::try_from(bounds.len()).is_ok(),
         "a BVH holds at most u32::MAX primitives"
@@ -66,7 +85,7 @@ pub(super) fn build(bounds: &[Aabb]) -> (Vec<BinaryNode>, Vec<u32>) {
             index: index as u32,
         })
         .collect();
-    let subtree = build_parallel(&mut prims, 0, 0);
+    let subtree = build_parallel(&mut prims, 0, 0, cost);
     let mut nodes = Vec::new();
     flatten(subtree, &mut nodes);
     (nodes, prims.iter().map(|prim| prim.index).collect())
@@ -102,19 +121,19 @@ enum Subtree {
     },
 }
 
-fn build_parallel(prims: &mut [Prim], first: usize, depth: usize) -> Subtree {
+fn build_parallel(prims: &mut [Prim], first: usize, depth: usize, cost: LeafCost) -> Subtree {
     if prims.len() < PARALLEL_THRESHOLD {
         let mut nodes = Vec::with_capacity(prims.len());
-        build_serial(prims, first, depth, &mut nodes);
+        build_serial(prims, first, depth, cost, &mut nodes);
         return Subtree::Nodes(nodes);
     }
-    match plan(prims, depth) {
+    match plan(prims, depth, cost) {
         Plan::Leaf { bounds } => Subtree::Nodes(vec![BinaryNode::leaf(bounds, first, prims.len())]),
         Plan::Split { bounds, mid } => {
             let (below, above) = prims.split_at_mut(mid);
             let children = rayon::join(
-                || build_parallel(below, first, depth + 1),
-                || build_parallel(above, first + mid, depth + 1),
+                || build_parallel(below, first, depth + 1, cost),
+                || build_parallel(above, first + mid, depth + 1, cost),
             );
             Subtree::Split {
                 bounds,
@@ -124,16 +143,16 @@ fn build_parallel(prims: &mut [Prim], first: usize, depth: usize) -> Subtree {
     }
 }
 
-fn build_serial(prims: &mut [Prim], first: usize, depth: usize, nodes: &mut Vec<BinaryNode>) {
-    match plan(prims, depth) {
+fn build_serial(prims: &mut [Prim], first: usize, depth: usize, cost: LeafCost, nodes: &mut Vec<BinaryNode>) {
+    match plan(prims, depth, cost) {
         Plan::Leaf { bounds } => nodes.push(BinaryNode::leaf(bounds, first, prims.len())),
         Plan::Split { bounds, mid } => {
             let index = nodes.len();
             nodes.push(BinaryNode::interior(bounds));
             let (below, above) = prims.split_at_mut(mid);
-            build_serial(below, first, depth + 1, nodes);
+            build_serial(below, first, depth + 1, cost, nodes);
             nodes[index].offset = nodes.len() as u32;
-            build_serial(above, first + mid, depth + 1, nodes);
+            build_serial(above, first + mid, depth + 1, cost, nodes);
         }
     }
 }
@@ -162,7 +181,7 @@ fn flatten(subtree: Subtree, nodes: &mut Vec<BinaryNode>) {
     }
 }
 
-fn plan(prims: &mut [Prim], depth: usize) -> Plan {
+fn plan(prims: &mut [Prim], depth: usize, cost: LeafCost) -> Plan {
     let (bounds, centroid_bounds) = prims
         .iter()
         .fold((Aabb::EMPTY, Aabb::EMPTY), |(b, c), prim| {
@@ -199,7 +218,7 @@ fn plan(prims: &mut [Prim], depth: usize) -> Plan {
         // even when a tiny spread makes `bins_per_unit` infinite.
         (((prim.centroid[axis] - low) * bins_per_unit) as usize).min(BIN_COUNT - 1)
     };
-    let Some((split_bin, split_cost)) = best_bin_split(prims, &bin_of) else {
+    let Some((split_bin, split_cost)) = best_bin_split(prims, &bin_of, cost) else {
         return if count <= MAX_LEAF_PRIMS {
             Plan::Leaf { bounds }
         } else {
@@ -209,7 +228,7 @@ fn plan(prims: &mut [Prim], depth: usize) -> Plan {
     // Costs are kept multiplied by the node's area, so a degenerate (zero-area) node needs no
     // division and simply compares 0 with 0, which chooses a leaf.
     let area = bounds.surface_area();
-    let leaf_cost = count as Real * area;
+    let leaf_cost = cost.tests(count) * area;
     if count <= MAX_LEAF_PRIMS && TRAVERSAL_COST * area + split_cost >= leaf_cost {
         return Plan::Leaf { bounds };
     }
@@ -219,7 +238,7 @@ fn plan(prims: &mut [Prim], depth: usize) -> Plan {
 
 /// The bin after which splitting is cheapest, with its cost `Σ count·area` over both sides.
 /// `None` when every primitive falls into a single bin.
-fn best_bin_split(prims: &[Prim], bin_of: &impl Fn(&Prim) -> usize) -> Option<(usize, Real)> {
+fn best_bin_split(prims: &[Prim], bin_of: &impl Fn(&Prim) -> usize, cost: LeafCost) -> Option<(usize, Real)> {
     let mut counts = [0usize; BIN_COUNT];
     let mut boxes = [Aabb::EMPTY; BIN_COUNT];
     for prim in prims {
@@ -232,7 +251,7 @@ fn best_bin_split(prims: &[Prim], bin_of: &impl Fn(&Prim) -> usize) -> Option<(u
     for bin in (1..BIN_COUNT).rev() {
         above_count += counts[bin];
         above_box = above_box.union(boxes[bin]);
-        above_cost[bin - 1] = above_count as Real * above_box.surface_area();
+        above_cost[bin - 1] = cost.tests(above_count) * above_box.surface_area();
     }
     let (mut below_count, mut below_box) = (0, Aabb::EMPTY);
     let mut best: Option<(usize, Real)> = None;
@@ -242,9 +261,9 @@ fn best_bin_split(prims: &[Prim], bin_of: &impl Fn(&Prim) -> usize) -> Option<(u
         if below_count == 0 || below_count == prims.len() {
             continue;
         }
-        let cost = below_count as Real * below_box.surface_area() + above_cost[split];
-        if best.is_none_or(|(_, best_cost)| cost < best_cost) {
-            best = Some((split, cost));
+        let split_cost = cost.tests(below_count) * below_box.surface_area() + above_cost[split];
+        if best.is_none_or(|(_, best_cost)| split_cost < best_cost) {
+            best = Some((split, split_cost));
         }
     }
     best
