@@ -185,7 +185,8 @@ impl Bvh {
         self.bounds
     }
 
-    pub(super) fn nodes(&self) -> &[BvhNode] {
+    /// The nodes, for [`traverse`].
+    pub fn nodes(&self) -> &[BvhNode] {
         &self.nodes
     }
 
@@ -360,7 +361,7 @@ impl Stack {
 ///
 /// A kernel: compile it only inside one (see `crate::simd`).
 #[inline(always)]
-pub(super) fn traverse<I: Isa>(
+pub fn traverse<I: Isa>(
     nodes: &[BvhNode],
     ray: &Ray,
     t_max: Real,

@@ -18,13 +18,14 @@ impl Plane {
         Plane { normal: normal / length, offset: offset / length }
     }
 
+    /// Where the ray meets the plane in `(0, t_max]`.
     pub fn intersect(&self, ray: &Ray, t_max: Real) -> Option<Real> {
         let denominator = self.normal.dot(ray.direction);
         if denominator == 0.0 {
             return None;
         }
         let t = (self.offset - self.normal.dot(ray.origin)) / denominator;
-        (t > 0.0 && t < t_max && t.is_finite()).then_some(t)
+        (t > 0.0 && t <= t_max && t.is_finite()).then_some(t)
     }
 
     /// The hit point is projected back onto the plane, which leaves an error proportional to the

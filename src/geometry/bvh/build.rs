@@ -31,13 +31,24 @@ pub enum LeafCost {
     /// Primitives are tested four at a time (a mesh's triangle packs): a leaf of `n` costs
     /// `⌈n/4⌉` tests, so leaves fill up to four.
     PerPackOfFour,
+    /// Every primitive is a leaf of its own, behind its own box: for primitives whose test costs
+    /// far more than a box (a scene's objects: instances move the ray into their space first).
+    Single,
 }
 
 impl LeafCost {
     fn tests(self, count: usize) -> Real {
         match self {
-            LeafCost::PerPrimitive => count as Real,
+            LeafCost::PerPrimitive | LeafCost::Single => count as Real,
             LeafCost::PerPackOfFour => count.div_ceil(4) as Real,
+        }
+    }
+
+    /// The most primitives a leaf may hold.
+    fn max_leaf(self) -> usize {
+        match self {
+            LeafCost::Single => 1,
+            _ => MAX_LEAF_PRIMS,
         }
     }
 }
@@ -196,7 +207,7 @@ fn plan(prims: &mut [Prim], depth: usize, cost: LeafCost) -> Plan {
     if spread.is_nan() || spread <= 0.0 {
         // All centroids coincide (or are not finite): no position separates them, so halve
         // the list as it is.
-        return if count <= MAX_LEAF_PRIMS {
+        return if count <= cost.max_leaf() {
             Plan::Leaf { bounds }
         } else {
             Plan::Split {
@@ -206,7 +217,7 @@ fn plan(prims: &mut [Prim], depth: usize, cost: LeafCost) -> Plan {
         };
     }
     if depth >= SAH_DEPTH_LIMIT {
-        return if count <= MAX_LEAF_PRIMS {
+        return if count <= cost.max_leaf() {
             Plan::Leaf { bounds }
         } else {
             median_split(prims, bounds, axis)
@@ -219,7 +230,7 @@ fn plan(prims: &mut [Prim], depth: usize, cost: LeafCost) -> Plan {
         (((prim.centroid[axis] - low) * bins_per_unit) as usize).min(BIN_COUNT - 1)
     };
     let Some((split_bin, split_cost)) = best_bin_split(prims, &bin_of, cost) else {
-        return if count <= MAX_LEAF_PRIMS {
+        return if count <= cost.max_leaf() {
             Plan::Leaf { bounds }
         } else {
             median_split(prims, bounds, axis)
@@ -229,7 +240,7 @@ fn plan(prims: &mut [Prim], depth: usize, cost: LeafCost) -> Plan {
     // division and simply compares 0 with 0, which chooses a leaf.
     let area = bounds.surface_area();
     let leaf_cost = cost.tests(count) * area;
-    if count <= MAX_LEAF_PRIMS && TRAVERSAL_COST * area + split_cost >= leaf_cost {
+    if count <= cost.max_leaf() && TRAVERSAL_COST * area + split_cost >= leaf_cost {
         return Plan::Leaf { bounds };
     }
     let mid = partition(prims, |prim| bin_of(prim) <= split_bin);
