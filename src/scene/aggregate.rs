@@ -105,6 +105,11 @@ impl Aggregate {
         &self.objects
     }
 
+    /// The infinite planes and their materials.
+    pub fn planes(&self) -> &[(Plane, u32)] {
+        &self.planes
+    }
+
     /// The tree over the objects that are neither planes nor a handful of plain spheres, when
     /// there are at least two of them.
     pub fn bvh(&self) -> Option<&Bvh> {
