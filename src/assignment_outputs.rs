@@ -8,6 +8,9 @@ use rayon::prelude::*;
 use crate::atomic_write::write_file_atomic;
 use crate::film::{Film, OutputError, Tonemap, color_image, depth_image, encode_exr, encode_png, normals_image};
 
+/// Encodes one output file.
+type Encode<'a> = Box<dyn Fn() -> Result<Vec<u8>, OutputError> + Sync + 'a>;
+
 /// Where `goldray mit6837` writes, mirroring the course binary's `-output`, `-normals` and
 /// `-depth min max file` flags.
 #[derive(Clone, Debug, Default)]
@@ -29,7 +32,7 @@ impl AssignmentOutputs {
     /// each file is then replaced atomically. The files are encoded in parallel.
     pub fn write(&self, film: &Film) -> Result<Vec<PathBuf>, OutputError> {
         let tonemap = Tonemap::Clamp;
-        let mut jobs: Vec<(&Path, Box<dyn Fn() -> Result<Vec<u8>, OutputError> + Sync + '_>)> = Vec::new();
+        let mut jobs: Vec<(&Path, Encode)> = Vec::new();
         if let Some(path) = &self.color {
             jobs.push((path, Box::new(move || encode_png(&color_image(film, tonemap)))));
         }
