@@ -56,6 +56,8 @@ pub fn normals_image(film: &Film, tonemap: Tonemap) -> RgbImage {
 fn quantised_image(film: &Film, tonemap: Tonemap, value: impl Fn(usize) -> [f32; 3] + Sync) -> RgbImage {
     /// Rows per parallel work item.
     const BAND_ROWS: usize = 16;
+    /// Pixels whose values are gathered, then quantised together.
+    const RUN: usize = 64;
     let width = film.width as usize;
     let mut bytes = vec![0; width * film.height as usize * 3];
     if width > 0 {
@@ -64,13 +66,33 @@ fn quantised_image(film: &Film, tonemap: Tonemap, value: impl Fn(usize) -> [f32;
             .enumerate()
             .for_each(|(band, out)| {
                 let first = band * width * BAND_ROWS;
-                for (offset, pixel) in out.chunks_exact_mut(3).enumerate() {
-                    let [r, g, b] = value(first + offset);
-                    pixel.copy_from_slice(&[quantise(r, tonemap), quantise(g, tonemap), quantise(b, tonemap)]);
+                let mut values = [0.0; 3 * RUN];
+                for (run, out) in out.chunks_mut(3 * RUN).enumerate() {
+                    let values = &mut values[..out.len()];
+                    for (k, pixel) in values.chunks_exact_mut(3).enumerate() {
+                        pixel.copy_from_slice(&value(first + run * RUN + k));
+                    }
+                    quantise_run(values, tonemap, out);
                 }
             });
     }
     RgbImage::from_raw(film.width, film.height, bytes).expect("three bytes per pixel")
+}
+
+/// [`quantise`] of each value into `out`. With `Clamp`, a run whose values all lie in [0, 1]
+/// (where `quantise` is plain `trunc(v·255)`) is converted in one loop the compiler vectorises;
+/// any other run, value by value.
+fn quantise_run(values: &[f32], tonemap: Tonemap, out: &mut [u8]) {
+    let in_unit_range = values.iter().fold(true, |all, &v| all & (v >= 0.0) & (v <= 1.0));
+    if tonemap == Tonemap::Clamp && in_unit_range {
+        for (byte, &v) in out.iter_mut().zip(values) {
+            *byte = (v * 255.0) as i32 as u8;
+        }
+    } else {
+        for (byte, &v) in out.iter_mut().zip(values) {
+            *byte = quantise(v, tonemap);
+        }
+    }
 }
 
 /// `Clamp` truncates like the assignment's `(int)(c·255)`, `Srgb` rounds to nearest. NaN is 0 and
