@@ -135,14 +135,25 @@ impl Bvh {
         )
     }
 
-    /// Every leaf as `(first, count)` in primitive order.
+    /// Every leaf as `(first, count)` in primitive order (leaves hold consecutive runs of the
+    /// primitive order, and together all of it).
     pub fn leaves(&self) -> Vec<(u32, u32)> {
-        let mut leaves: Vec<(u32, u32)> = self
-            .nodes
-            .iter()
-            .flat_map(|node| (0..WIDTH).filter(|&lane| node.count[lane] > 0).map(|lane| (node.child[lane], node.count[lane])))
-            .collect();
-        leaves.sort_unstable();
+        let mut count_at = vec![0u32; self.prim_indices.len()];
+        for node in &self.nodes {
+            for lane in 0..WIDTH {
+                if node.count[lane] > 0 {
+                    count_at[node.child[lane] as usize] = node.count[lane];
+                }
+            }
+        }
+        let mut leaves = Vec::new();
+        let mut first = 0;
+        while first < count_at.len() {
+            let count = count_at[first];
+            debug_assert!(count > 0, "leaves cover the primitive order");
+            leaves.push((first as u32, count));
+            first += count.max(1) as usize;
+        }
         leaves
     }
 
@@ -322,28 +333,47 @@ fn sort_key(t: Real, lane: usize) -> u64 {
     key | lane as u64
 }
 
-/// The traversal stack: sized so that it cannot overflow (see `STACK_SIZE`) and, unlike an
-/// array, not initialised, since zeroing the whole bound for every ray would cost more than most
-/// rays push.
+/// Entries the traversal stack holds in place before it spills to the heap. Rays rarely need
+/// more than a few dozen, and a small frame keeps the kernels that do not traverse cheap.
+const INLINE_STACK: usize = 64;
+
+/// The traversal stack: `INLINE_STACK` entries inline and, unlike an array, not initialised
+/// (zeroing them for every ray would cost more than most rays push), then a vector for the
+/// deepest trees (at most `STACK_SIZE` entries in all), allocated only if ever needed.
 struct Stack {
-    entries: [MaybeUninit<Pending>; STACK_SIZE],
+    entries: [MaybeUninit<Pending>; INLINE_STACK],
     len: usize,
+    spilled: Vec<Pending>,
 }
 
 impl Stack {
     #[inline(always)]
     fn new() -> Self {
-        Stack { entries: [const { MaybeUninit::uninit() }; STACK_SIZE], len: 0 }
+        Stack { entries: [const { MaybeUninit::uninit() }; INLINE_STACK], len: 0, spilled: Vec::new() }
     }
 
     #[inline(always)]
     fn push(&mut self, entry: Pending) {
-        self.entries[self.len] = MaybeUninit::new(entry);
-        self.len += 1;
+        if self.len < INLINE_STACK {
+            self.entries[self.len] = MaybeUninit::new(entry);
+            self.len += 1;
+        } else {
+            self.spill(entry);
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn spill(&mut self, entry: Pending) {
+        debug_assert!(self.spilled.len() + INLINE_STACK < STACK_SIZE);
+        self.spilled.push(entry);
     }
 
     #[inline(always)]
     fn pop(&mut self) -> Option<Pending> {
+        if !self.spilled.is_empty() {
+            return self.spilled.pop();
+        }
         if self.len == 0 {
             return None;
         }

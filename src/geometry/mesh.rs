@@ -12,6 +12,7 @@ use super::{Ray, SurfaceHit};
 use super::real::{Real, Vec3};
 pub use crate::build_error::MeshError;
 use crate::simd::{Isa, Kernel, dispatch};
+use rayon::prelude::*;
 
 /// The vertex normals a mesh is built with.
 #[derive(Clone, Debug)]
@@ -88,25 +89,17 @@ impl Mesh {
                 (unit, normal_triangles)
             }
         };
-        let corners_of = |[a, b, c]: [u32; 3]| {
-            [
-                positions[a as usize],
-                positions[b as usize],
-                positions[c as usize],
-            ]
-        };
-        let bounds: Vec<Aabb> = triangles
-            .iter()
-            .map(|&t| Aabb::from_points(corners_of(t)))
-            .collect();
+        let corners_of = |[a, b, c]: [u32; 3]| [positions[a as usize], positions[b as usize], positions[c as usize]];
         let build_start = Instant::now();
+        let bounds: Vec<Aabb> = triangles.par_iter().map(|&t| Aabb::from_points(corners_of(t))).collect();
         let (mut bvh, order) = Bvh::build_for(&bounds, LeafCost::PerPackOfFour).into_leaf_order();
-        let corners: Vec<[Vec3; 3]> = order.iter().map(|&i| corners_of(triangles[i as usize])).collect();
+        drop(bounds);
+        let corners: Vec<[Vec3; 3]> = order.par_iter().map(|&i| corners_of(triangles[i as usize])).collect();
         let packs = pack_leaves(&mut bvh, &corners);
         let bvh_build_time = build_start.elapsed();
         Ok(Mesh {
             corners,
-            normal_indices: order.iter().map(|&i| normal_indices[i as usize]).collect(),
+            normal_indices: order.par_iter().map(|&i| normal_indices[i as usize]).collect(),
             normals,
             packs,
             bvh,
@@ -227,7 +220,9 @@ impl Mesh {
         &self.bvh
     }
 
-    /// How long [`Mesh::new`] took to build the BVH (the rest of a load is reading the file).
+    /// How long [`Mesh::new`] took to build what rays are traced through: the triangles' boxes,
+    /// the BVH and the triangle packs (the rest of a load is reading the file, checking it and
+    /// the vertex normals).
     pub fn bvh_build_time(&self) -> Duration {
         self.bvh_build_time
     }
@@ -237,18 +232,27 @@ impl Mesh {
 /// points the leaf at its packs.
 fn pack_leaves(bvh: &mut Bvh, corners: &[[Vec3; 3]]) -> Vec<TrianglePack> {
     let leaves = bvh.leaves();
-    let mut packs = Vec::with_capacity(corners.len() / 3 + 1);
-    let mut first_pack = Vec::with_capacity(leaves.len());
+    // Where each leaf's packs start, by the leaf's first triangle.
+    let mut first_pack = vec![0u32; corners.len()];
+    let mut packed = 0;
     for &(first, count) in &leaves {
-        first_pack.push(packs.len() as u32);
-        let triangles: Vec<(u32, [Vec3; 3])> =
-            (first..first + count).map(|index| (index, corners[index as usize])).collect();
-        packs.extend(triangles.chunks(4).map(TrianglePack::new));
+        first_pack[first as usize] = packed;
+        packed += count.div_ceil(4);
     }
-    bvh.remap_leaves(|first, count| {
-        let leaf = leaves.binary_search(&(first, count)).expect("every leaf was packed");
-        (first_pack[leaf], count.div_ceil(4))
-    });
+    let packs = leaves
+        .par_iter()
+        .flat_map_iter(|&(first, count)| {
+            (first..first + count).step_by(4).map(move |start| {
+                let end = (start + 4).min(first + count);
+                let mut lanes = [(0, [Vec3::ZERO; 3]); 4];
+                for (lane, index) in (start..end).enumerate() {
+                    lanes[lane] = (index, corners[index as usize]);
+                }
+                TrianglePack::new(&lanes[..(end - start) as usize])
+            })
+        })
+        .collect();
+    bvh.remap_leaves(|first, count| (first_pack[first as usize], count.div_ceil(4)));
     packs
 }
 
@@ -308,18 +312,23 @@ fn validate_normal_indices(
 /// One unit normal per position, following [`VertexNormals::Averaged`]; zero where the sum
 /// cannot be normalised (no usable face, or faces cancelling out).
 fn averaged_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
+    // The face normals in parallel; their sums in triangle order, as always.
+    let faces: Vec<Option<Vec3>> = triangles
+        .par_iter()
+        .map(|corners| {
+            let [p0, p1, p2] = corners.map(|i| positions[i as usize]);
+            face_normal(p0, p1, p2)
+        })
+        .collect();
     let mut sums = vec![Vec3::ZERO; positions.len()];
-    for corners in triangles {
-        let [p0, p1, p2] = corners.map(|i| positions[i as usize]);
-        if let Some(normal) = face_normal(p0, p1, p2) {
+    for (corners, face) in triangles.iter().zip(faces) {
+        if let Some(normal) = face {
             for &vertex in corners {
                 sums[vertex as usize] += normal;
             }
         }
     }
-    sums.into_iter()
-        .map(|sum| normalize(sum).unwrap_or(Vec3::ZERO))
-        .collect()
+    sums.into_par_iter().map(|sum| normalize(sum).unwrap_or(Vec3::ZERO)).collect()
 }
 
 #[cfg(test)]

@@ -3,22 +3,24 @@
 
 use super::geometry::aabb::{Aabb, SlabRay};
 use super::geometry::bvh::{Bvh, LeafCost, Visit, traverse};
-use super::geometry::plane::Plane;
-use super::geometry::sphere::{SphereRay, SpherePack, intersect_spheres};
+use super::geometry::plane::{PLANE_LANES, Plane, PlanePack, intersect_planes};
+use super::geometry::sphere::{SPHERE_LANES, SphereRay, SpherePack, intersect_spheres};
 use super::geometry::{Ray, SurfaceHit};
 use super::object::{Object, Shape, ShapeHit};
 use super::real::Real;
 use crate::simd::{Isa, Kernel, Lanes, dispatch};
 
-/// Up to this many untransformed spheres are tested on every ray, four at a time, which costs
+/// Up to this many untransformed spheres are tested on every ray, side by side, which costs
 /// less than the box tests of a tree; more go into the tree with everything else.
-const SPHERE_PACK_LIMIT: usize = 8;
+const SPHERE_PACK_LIMIT: usize = SPHERE_LANES;
 
 #[derive(Debug)]
 pub struct Aggregate {
     /// In the scene's order, which is also the order that breaks ties (see [`Aggregate::intersect`]).
     objects: Vec<Object>,
     planes: Vec<(Plane, u32)>,
+    /// The planes side by side, in order.
+    plane_packs: Vec<PlanePack>,
     /// The spheres tested side by side: untransformed, and no more than `SPHERE_PACK_LIMIT`.
     spheres: Vec<SpherePack>,
     /// The other objects.
@@ -78,7 +80,7 @@ impl Aggregate {
             })
             .collect();
         let packed = plain_spheres.len() <= SPHERE_PACK_LIMIT;
-        let spheres = if packed { plain_spheres.chunks(4).map(SpherePack::new).collect() } else { Vec::new() };
+        let spheres = if packed { plain_spheres.chunks(SPHERE_LANES).map(SpherePack::new).collect() } else { Vec::new() };
         let others: Vec<u32> = (0..objects.len() as u32)
             .filter(|&index| {
                 let object = &objects[index as usize];
@@ -98,7 +100,9 @@ impl Aggregate {
                 Rest::Tree { bvh, objects: in_leaf_order }
             }
         };
-        Aggregate { objects, planes, spheres, rest }
+        let plane_list: Vec<Plane> = planes.iter().map(|(plane, _)| *plane).collect();
+        let plane_packs = plane_list.chunks(PLANE_LANES).map(PlanePack::new).collect();
+        Aggregate { objects, planes, plane_packs, spheres, rest }
     }
 
     pub fn objects(&self) -> &[Object] {
@@ -150,7 +154,7 @@ impl Aggregate {
             for pack in &self.spheres {
                 let (mut lanes, t) = intersect_spheres::<I>(pack, &sphere_ray, closest.t);
                 if lanes != 0 {
-                    let mut t_lanes = [0.0; 4];
+                    let mut t_lanes = [0.0; SPHERE_LANES];
                     t.store(&mut t_lanes);
                     while lanes != 0 {
                         let lane = lanes.trailing_zeros() as usize;
@@ -162,9 +166,17 @@ impl Aggregate {
             }
         }
         let plane_ids = self.objects.len() as u32;
-        for (index, (plane, _)) in self.planes.iter().enumerate() {
-            if let Some(t) = plane.intersect(ray, closest.t) {
-                closest.offer(t, plane_ids + index as u32, Found::Plane(index, t));
+        for (k, pack) in self.plane_packs.iter().enumerate() {
+            let (mut lanes, t) = intersect_planes::<I>(pack, ray, closest.t);
+            if lanes != 0 {
+                let mut t_lanes = [0.0; PLANE_LANES];
+                t.store(&mut t_lanes);
+                while lanes != 0 {
+                    let lane = lanes.trailing_zeros() as usize;
+                    lanes &= lanes - 1;
+                    let index = k * PLANE_LANES + lane;
+                    closest.offer(t_lanes[lane], plane_ids + index as u32, Found::Plane(index, t_lanes[lane]));
+                }
             }
         }
         match &self.rest {
@@ -212,7 +224,7 @@ impl Aggregate {
                 return true;
             }
         }
-        if self.planes.iter().any(|(plane, _)| plane.intersect(ray, t_max).is_some()) {
+        if self.plane_packs.iter().any(|pack| intersect_planes::<I>(pack, ray, t_max).0 != 0) {
             return true;
         }
         match &self.rest {

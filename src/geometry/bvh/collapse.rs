@@ -59,5 +59,5 @@ fn children(binary: &[BinaryNode], index: usize) -> ([usize; WIDTH], usize) {
 }
 
 fn area(binary: &[BinaryNode], index: usize) -> Real {
-    binary[index].bounds.surface_area()
+    binary[index].area
 }
