@@ -20,6 +20,7 @@ pub mod options;
 pub mod pipeline;
 pub mod precision;
 pub mod progress;
+pub mod simd;
 pub mod stats;
 pub mod tradeoff;
 
