@@ -65,7 +65,10 @@ fn main() {
             let picture = match spec.output {
                 Output::Color => Picture::Color,
                 Output::Normals => Picture::Normals,
-                Output::Depth { min, max } => Picture::Depth { min: min as f32, max: max as f32 },
+                Output::Depth { min, max } => Picture::Depth {
+                    min: min as f32,
+                    max: max as f32,
+                },
             };
             let image = picture_with_faults(film, picture, Tonemap::Clamp, &faults);
             fs::write(folder.join(&spec.file), encode_png(&image).unwrap()).unwrap();
@@ -79,7 +82,10 @@ fn main() {
 
     let cache = dir.join("cache");
     let grade = |name: &str, diagnose: Diagnose| -> (f64, ClassReport) {
-        let options = GradeOptions { out: dir.join(name), cache: Some(cache.clone()) };
+        let options = GradeOptions {
+            out: dir.join(name),
+            cache: Some(cache.clone()),
+        };
         let started = Instant::now();
         let report = grade_class_diagnosing(&rubric_path, &submissions, &options, diagnose, &Silent)
             .unwrap_or_else(|e| panic!("{e}"));
@@ -97,6 +103,12 @@ fn main() {
     println!("images that lost points: {}, explained: {}", run.images, run.explained);
     println!("fault sets compared: {sets}, rendered on the cold run: {rendered}");
     println!("grading without diagnosis:          {without:7.1} s (again at the end: {again:.1} s)");
-    println!("with diagnosis, fault cache cold:   {cold:7.1} s ({:.2}x)", cold / without);
-    println!("with diagnosis, fault cache warm:   {warm:7.1} s ({:.2}x)", warm / without);
+    println!(
+        "with diagnosis, fault cache cold:   {cold:7.1} s ({:.2}x)",
+        cold / without
+    );
+    println!(
+        "with diagnosis, fault cache warm:   {warm:7.1} s ({:.2}x)",
+        warm / without
+    );
 }

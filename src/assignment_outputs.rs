@@ -3,8 +3,13 @@
 
 use std::path::{Path, PathBuf};
 
+use rayon::prelude::*;
+
 use crate::atomic_write::write_file_atomic;
 use crate::film::{Film, OutputError, Tonemap, color_image, depth_image, encode_exr, encode_png, normals_image};
+
+/// Encodes one output file.
+type Encode<'a> = Box<dyn Fn() -> Result<Vec<u8>, OutputError> + Sync + 'a>;
 
 /// Where `goldray mit6837` writes, mirroring the course binary's `-output`, `-normals` and
 /// `-depth min max file` flags.
@@ -24,22 +29,29 @@ impl AssignmentOutputs {
     }
 
     /// Encodes every file before writing any, so a film that cannot be encoded writes nothing;
-    /// each file is then replaced atomically.
+    /// each file is then replaced atomically. The files are encoded in parallel.
     pub fn write(&self, film: &Film) -> Result<Vec<PathBuf>, OutputError> {
         let tonemap = Tonemap::Clamp;
-        let mut files: Vec<(&Path, Vec<u8>)> = Vec::new();
+        let mut jobs: Vec<(&Path, Encode)> = Vec::new();
         if let Some(path) = &self.color {
-            files.push((path, encode_png(&color_image(film, tonemap))?));
+            jobs.push((path, Box::new(move || encode_png(&color_image(film, tonemap)))));
         }
         if let Some(path) = &self.normals {
-            files.push((path, encode_png(&normals_image(film, tonemap))?));
+            jobs.push((path, Box::new(move || encode_png(&normals_image(film, tonemap)))));
         }
         if let Some((min, max, path)) = &self.depth {
-            files.push((path, encode_png(&depth_image(film, *min, *max, tonemap))?));
+            jobs.push((
+                path,
+                Box::new(move || encode_png(&depth_image(film, *min, *max, tonemap))),
+            ));
         }
         if let Some(path) = &self.exr {
-            files.push((path, encode_exr(film)?));
+            jobs.push((path, Box::new(move || encode_exr(film))));
         }
+        let files = jobs
+            .par_iter()
+            .map(|(path, encode)| Ok((*path, encode()?)))
+            .collect::<Result<Vec<(&Path, Vec<u8>)>, OutputError>>()?;
         for (path, bytes) in &files {
             write_file_atomic(path, bytes)?;
         }

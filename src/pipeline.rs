@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use crate::assignment_outputs::AssignmentOutputs;
+use crate::build_error::BuildError;
 use crate::case::{
     self, AssignmentOptions, Case, LoadOptions, case_to_toml, case_to_toml_anywhere, load_assignment_scene,
 };
@@ -33,7 +34,11 @@ pub fn render_case(case: &Case) -> Result<Film, Error> {
 pub fn render_case_reporting(case: &Case, progress: &dyn Progress) -> Result<Film, Error> {
     with_precision!(case.render.precision, p => {
         let scene = p::scene::build_scene(case)?;
-        Ok(rendering(case, progress, |progress| p::render::render(&scene, &render_options(case), progress)))
+        let film = rendering(case, progress, |progress| p::render::render(&scene, &render_options(case), progress));
+        match scene.render_failure() {
+            Some(source) => Err(BuildError::CubeMap { file: case.path.clone(), source }.into()),
+            None => Ok(film),
+        }
     })
 }
 
@@ -56,6 +61,9 @@ pub fn render_case_measured(case: &Case, progress: &dyn Progress, aovs: bool) ->
         let render_start = Instant::now();
         let options = RenderOptions { aovs, ..render_options(case) };
         let (film, rays) = rendering(case, progress, |progress| p::render::render_counting_rays(&scene, &options, progress));
+        if let Some(source) = scene.render_failure() {
+            return Err(BuildError::CubeMap { file: case.path.clone(), source }.into());
+        }
         Ok(MeasuredRender { film, rays, build_stats, build_time, render_time: render_start.elapsed() })
     })
 }

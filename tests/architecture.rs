@@ -11,6 +11,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("image_size", 0),
     ("progress", 0),
     ("named_enum", 0),
+    ("simd", 0),
     ("located_toml", 1),
     ("build_error", 2),
     ("options", 2),

@@ -21,6 +21,7 @@ use super::sections::MAX_BOUNCES;
 use super::spec::{BackgroundSpec, Case, MaterialSpec};
 use super::value::has_usable_length;
 use crate::film::Tonemap;
+use crate::located_toml::ReadError;
 use crate::options::{Filter, Precision, Profile, Trace};
 
 /// The course binary's command-line flags that shape a render (`-size`, `-bounces`, `-shadows`,
@@ -62,10 +63,7 @@ const BLOCKS: &[&str] = &["PerspectiveCamera", "Background", "Lights", "Material
 const AMBIENT_WITHOUT_LIGHTS: [f64; 3] = [1.0; 3];
 
 pub fn load_assignment_scene(path: &Path, options: &AssignmentOptions) -> Result<Case> {
-    let bytes = std::fs::read(path).map_err(|source| CaseError::Read {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let bytes = ReadError::read(path, "case file")?;
     let source = String::from_utf8(bytes).map_err(|e| {
         let valid = e.utf8_error().valid_up_to();
         let bytes = e.as_bytes();

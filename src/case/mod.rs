@@ -27,7 +27,7 @@ pub use spec::{
     composite_matrix,
 };
 
-use crate::located_toml::{self, Doc, Table};
+use crate::located_toml::{self, Doc, ReadError, Table};
 
 #[derive(Clone, Debug, Default)]
 pub struct LoadOptions {
@@ -47,10 +47,7 @@ const TOP_LEVEL_KEYS: &[&str] = &[
 ];
 
 pub fn load(path: &Path, options: &LoadOptions) -> Result<Case, CaseError> {
-    let source = std::fs::read_to_string(path).map_err(|source| CaseError::Read {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let source = ReadError::read_text(path, "case file")?;
     parse(&source, path, options)
 }
 

@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use image::RgbImage;
+use rayon::prelude::*;
 
 use super::error::OutputError;
 use super::exr::encode_exr_named;
@@ -37,20 +38,31 @@ pub fn write_outputs(
         return Err(OutputError::InvalidName { name: name.to_owned() });
     }
     let path = |suffix: &str| dir.join(format!("{name}{suffix}"));
-    let png = |path: PathBuf, image: RgbImage| -> Result<(PathBuf, Vec<u8>), OutputError> {
-        let bytes = encode_png_named(&image, &path.display().to_string())?;
+    let png = |path: PathBuf, image: &dyn Fn() -> RgbImage| -> Result<(PathBuf, Vec<u8>), OutputError> {
+        let bytes = encode_png_named(&image(), &path.display().to_string())?;
         Ok((path, bytes))
     };
 
+    // Encoded in parallel (the EXR on one thread, so its bytes stay a function of the film).
+    let tonemap = options.tonemap;
+    let previews = || -> Result<Vec<(PathBuf, Vec<u8>)>, OutputError> {
+        let mut jobs: Vec<(PathBuf, Box<dyn Fn() -> RgbImage + Send + Sync>)> =
+            vec![(path(".png"), Box::new(move || color_image(film, tonemap)))];
+        if let Some((min, max)) = options.depth_range {
+            jobs.push((
+                path("_depth.png"),
+                Box::new(move || depth_image(film, min, max, tonemap)),
+            ));
+        }
+        if options.normals {
+            jobs.push((path("_normals.png"), Box::new(move || normals_image(film, tonemap))));
+        }
+        jobs.into_par_iter().map(|(path, image)| png(path, &*image)).collect()
+    };
     let exr_path = path(".exr");
-    let exr = encode_exr_named(film, &exr_path.display().to_string())?;
-    let mut files = vec![(exr_path, exr), png(path(".png"), color_image(film, options.tonemap))?];
-    if let Some((min, max)) = options.depth_range {
-        files.push(png(path("_depth.png"), depth_image(film, min, max, options.tonemap))?);
-    }
-    if options.normals {
-        files.push(png(path("_normals.png"), normals_image(film, options.tonemap))?);
-    }
+    let (exr, previews) = rayon::join(|| encode_exr_named(film, &exr_path.display().to_string()), previews);
+    let mut files = vec![(exr_path.clone(), exr?)];
+    files.extend(previews?);
 
     let pending: Vec<(&Path, &[u8])> = files.iter().map(|(p, b)| (p.as_path(), &b[..])).collect();
     write_files_atomic(dir, &pending)?;

@@ -2,19 +2,24 @@
 //!
 //! The BVH never sees the primitives themselves: callers pass one box per primitive to
 //! [`Bvh::build`] and a closure to the traversals that tests a primitive by index. That keeps
-//! one implementation for triangle meshes and for scene-level object lists.
+//! one implementation for triangle meshes and for scene-level object lists; meshes replace the
+//! leaves' primitive runs by runs of triangle packs ([`Bvh::remap_leaves`]) and traverse with
+//! their own leaf test ([`traverse`]).
 
 mod build;
 mod collapse;
 
-use smallvec::SmallVec;
+use std::mem::MaybeUninit;
 
 use super::Ray;
-use super::aabb::{Aabb, SlabRay, hit_lanes};
-use super::real::Real;
+use super::aabb::Aabb;
+use super::real::{R8, Real, gamma};
+use crate::simd::{Isa, Kernel, Lanes, MaskOps, dispatch};
 
-/// Children per node: four boxes are tested at once, one per SIMD lane.
-const WIDTH: usize = 4;
+pub use build::LeafCost;
+
+/// Children per node: eight boxes are tested at once, one per SIMD lane.
+pub const WIDTH: usize = 8;
 
 /// Deepest binary tree [`Bvh::build`] can produce: SAH splits are allowed up to
 /// `build::SAH_DEPTH_LIMIT` levels, after which median splits at most halve `u32::MAX` primitives
@@ -23,17 +28,18 @@ const WIDTH: usize = 4;
 /// overflow.
 const STACK_SIZE: usize = (WIDTH - 1) * (build::SAH_DEPTH_LIMIT + 33) + 1;
 
-/// One node of the 4-wide tree: the boxes of its (up to four) children side by side, one lane
-/// per child, so that one slab test covers all four. 128 bytes with `f32` bounds, aligned to
-/// two whole cache lines.
+/// One node of the 8-wide tree: the boxes of its (up to eight) children side by side, one lane
+/// per child, so that one slab test covers all eight. 256 bytes with `f32` bounds, aligned to
+/// whole cache lines.
 ///
 /// A child is either another node or a leaf, a run of primitives stored in the node itself.
 /// Unused slots have an empty box, which no ray enters.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(64))]
 pub struct BvhNode {
-    min: [[Real; WIDTH]; 3],
-    max: [[Real; WIDTH]; 3],
+    /// `bounds[0]` holds the children's minimum corners, `bounds[1]` their maximum ones, by axis
+    /// and then lane.
+    bounds: [[[Real; WIDTH]; 3]; 2],
     /// Interior child: its node's index. Leaf: the index of its first entry in the primitive order.
     child: [u32; WIDTH],
     /// Leaf: its number of primitives (at least one). Zero for an interior child or unused slot.
@@ -42,16 +48,15 @@ pub struct BvhNode {
 
 impl BvhNode {
     const EMPTY: BvhNode = BvhNode {
-        min: [[Real::INFINITY; WIDTH]; 3],
-        max: [[Real::NEG_INFINITY; WIDTH]; 3],
+        bounds: [[[Real::INFINITY; WIDTH]; 3], [[Real::NEG_INFINITY; WIDTH]; 3]],
         child: [0; WIDTH],
         count: [0; WIDTH],
     };
 
     fn set_child(&mut self, lane: usize, bounds: &Aabb, child: u32, count: u32) {
         for axis in 0..3 {
-            self.min[axis][lane] = bounds.min[axis];
-            self.max[axis][lane] = bounds.max[axis];
+            self.bounds[0][axis][lane] = bounds.min[axis];
+            self.bounds[1][axis][lane] = bounds.max[axis];
         }
         self.child[lane] = child;
         self.count[lane] = count;
@@ -74,7 +79,7 @@ struct Pending {
 }
 
 /// What a traversal visitor asks the traversal to do next.
-enum Visit {
+pub enum Visit {
     Continue,
     Stop,
 }
@@ -88,8 +93,9 @@ pub struct Bvh {
 }
 
 impl Bvh {
-    /// Builds a binary tree with a binned surface-area heuristic and collapses it into a 4-wide
-    /// one (nodes of up to four children).
+    /// Builds a binary tree with a binned surface-area heuristic and collapses it into an 8-wide
+    /// one (nodes of up to eight children), with leaves of up to four primitives each tested
+    /// on its own.
     ///
     /// Deterministic: the tree depends only on `bounds`, never on the number of rayon threads
     /// that build its subtrees. Boxes may be empty or degenerate (points, identical copies);
@@ -98,7 +104,13 @@ impl Bvh {
     /// # Panics
     /// If there are more than `u32::MAX` primitives.
     pub fn build(bounds: &[Aabb]) -> Bvh {
-        let (binary, prim_indices) = build::build(bounds);
+        Bvh::build_for(bounds, LeafCost::PerPrimitive)
+    }
+
+    /// [`Bvh::build`] for leaves whose primitives are tested as `cost` says (a mesh tests up to
+    /// four triangles at once, so a leaf of four costs what a leaf of one does).
+    pub fn build_for(bounds: &[Aabb], cost: LeafCost) -> Bvh {
+        let (binary, prim_indices) = build::build(bounds, cost);
         Bvh {
             bounds: binary.first().map_or(Aabb::EMPTY, |root| root.bounds),
             nodes: collapse::collapse(&binary),
@@ -123,6 +135,42 @@ impl Bvh {
         )
     }
 
+    /// Every leaf as `(first, count)` in primitive order (leaves hold consecutive runs of the
+    /// primitive order, and together all of it).
+    pub fn leaves(&self) -> Vec<(u32, u32)> {
+        let mut count_at = vec![0u32; self.prim_indices.len()];
+        for node in &self.nodes {
+            for lane in 0..WIDTH {
+                if node.count[lane] > 0 {
+                    count_at[node.child[lane] as usize] = node.count[lane];
+                }
+            }
+        }
+        let mut leaves = Vec::new();
+        let mut first = 0;
+        while first < count_at.len() {
+            let count = count_at[first];
+            debug_assert!(count > 0, "leaves cover the primitive order");
+            leaves.push((first as u32, count));
+            first += count.max(1) as usize;
+        }
+        leaves
+    }
+
+    /// Replaces each leaf's `(first, count)` by `remap(first, count)`: how a mesh points its
+    /// leaves at the packs of triangles it made of them. Only [`traverse`] with the caller's own
+    /// leaf test makes sense afterwards.
+    pub fn remap_leaves(&mut self, mut remap: impl FnMut(u32, u32) -> (u32, u32)) {
+        for node in &mut self.nodes {
+            for lane in 0..WIDTH {
+                if node.count[lane] > 0 {
+                    (node.child[lane], node.count[lane]) = remap(node.child[lane], node.count[lane]);
+                    debug_assert!(node.count[lane] > 0, "a leaf keeps at least one entry");
+                }
+            }
+        }
+    }
+
     /// The original primitive indices in leaf order.
     pub fn prim_indices(&self) -> &[u32] {
         &self.prim_indices
@@ -133,7 +181,7 @@ impl Bvh {
         self.prim_indices.len()
     }
 
-    /// Number of (4-wide) nodes.
+    /// Number of (8-wide) nodes.
     pub fn node_count(&self) -> usize {
         self.nodes.len()
     }
@@ -148,11 +196,20 @@ impl Bvh {
         self.bounds
     }
 
+    /// The nodes, for [`traverse`].
+    pub fn nodes(&self) -> &[BvhNode] {
+        &self.nodes
+    }
+
     /// Finds the nearest primitive along the ray in `(0, t_max]`.
     ///
     /// `test(prim, t_limit)` must return `Some(t)` only for a hit with `t <= t_limit`; the limit
     /// then shrinks to `t`, so later boxes and primitives beyond it are skipped. The caller
     /// records whatever it needs about the hit inside `test`; the final `t` is returned.
+    ///
+    /// Boxes entered exactly at the limit are still visited, so a test that also breaks ties of
+    /// `t` by a fixed rule (as `scene::Aggregate` does, by object index) finds the same hit
+    /// whatever order the boxes are visited in.
     pub fn closest(
         &self,
         ray: &Ray,
@@ -160,14 +217,14 @@ impl Bvh {
         mut test: impl FnMut(u32, Real) -> Option<Real>,
     ) -> Option<Real> {
         let mut nearest = None;
-        self.traverse(ray, t_max, |prim, t_limit| {
-            if let Some(t) = test(prim, *t_limit) {
-                debug_assert!(
-                    t <= *t_limit,
-                    "closest: test returned a hit beyond its limit"
-                );
-                *t_limit = t;
-                nearest = Some(t);
+        let prims = &self.prim_indices;
+        self.traverse(ray, t_max, |first, count, t_limit| {
+            for &prim in &prims[first as usize..(first + count) as usize] {
+                if let Some(t) = test(prim, *t_limit) {
+                    debug_assert!(t <= *t_limit, "closest: test returned a hit beyond its limit");
+                    *t_limit = t;
+                    nearest = Some(t);
+                }
             }
             Visit::Continue
         });
@@ -177,8 +234,9 @@ impl Bvh {
     /// Whether any primitive is hit in `(0, t_max]`; stops at the first one `test` accepts.
     pub fn any(&self, ray: &Ray, t_max: Real, mut test: impl FnMut(u32, Real) -> bool) -> bool {
         let mut found = false;
-        self.traverse(ray, t_max, |prim, t_limit| {
-            if test(prim, *t_limit) {
+        let prims = &self.prim_indices;
+        self.traverse(ray, t_max, |first, count, t_limit| {
+            if prims[first as usize..(first + count) as usize].iter().any(|&prim| test(prim, *t_limit)) {
                 found = true;
                 Visit::Stop
             } else {
@@ -188,61 +246,217 @@ impl Bvh {
         found
     }
 
-    /// Depth-first traversal with an explicit stack, nearest child first: each node's four boxes
-    /// are tested at once, the children hit are ordered by where the ray enters them, the
-    /// nearest is visited next and the others wait on the stack with their entry distance. The
-    /// visitor may shrink `t_limit`, which prunes every box entered beyond it.
-    fn traverse(&self, ray: &Ray, t_max: Real, mut visit: impl FnMut(u32, &mut Real) -> Visit) {
-        if self.nodes.is_empty() || !(ray.origin.is_finite() && ray.direction.is_finite()) {
-            return;
+    /// [`traverse`] on the current SIMD path.
+    fn traverse(&self, ray: &Ray, t_max: Real, visit: impl FnMut(u32, u32, &mut Real) -> Visit) {
+        struct Traversal<'a, V> {
+            nodes: &'a [BvhNode],
+            ray: &'a Ray,
+            t_max: Real,
+            visit: V,
         }
-        let slab_ray = SlabRay::new(ray);
-        let mut t_limit = t_max;
-        // Inline storage that is never spilled (see `STACK_SIZE`) and, unlike an array, not
-        // initialised: zeroing the whole bound for every ray would cost more than most rays push.
-        let mut stack: SmallVec<[Pending; STACK_SIZE]> = SmallVec::new();
-        let mut current = Pending { t: 0.0, index: 0, count: 0 };
-        loop {
-            if current.count == 0 {
-                let node = &self.nodes[current.index as usize];
-                let (t_enter, hit) = hit_lanes(&node.min, &node.max, &slab_ray, t_limit);
-                // Insertion sort of the (at most four) children hit, nearest first.
-                let mut near = [current; WIDTH];
-                let mut near_len = 0;
-                for lane in 0..WIDTH {
-                    if hit[lane] {
-                        let child = Pending { t: t_enter[lane], index: node.child[lane], count: node.count[lane] };
-                        let mut k = near_len;
-                        while k > 0 && near[k - 1].t > child.t {
-                            near[k] = near[k - 1];
-                            k -= 1;
-                        }
-                        near[k] = child;
-                        near_len += 1;
-                    }
-                }
-                if near_len > 0 {
-                    for &farther in near[1..near_len].iter().rev() {
-                        stack.push(farther);
-                    }
-                    current = near[0];
+        impl<V: FnMut(u32, u32, &mut Real) -> Visit> Kernel for Traversal<'_, V> {
+            type Output = ();
+            #[inline(always)]
+            fn run<I: Isa>(self) {
+                traverse::<I>(self.nodes, self.ray, self.t_max, self.visit);
+            }
+        }
+        dispatch(Traversal { nodes: &self.nodes, ray, t_max, visit });
+    }
+}
+
+/// The per-ray part of the slab test, splatted across the lanes once per ray.
+struct SlabLanes<I: Isa> {
+    origin: [R8<I>; 3],
+    /// `1 / direction` per component; ±∞ where the direction component is ±0.
+    inverse: [R8<I>; 3],
+    /// The inverse widened by `1 + 2·gamma(3)`, for the far planes (see [`node_hits`]).
+    far_inverse: [R8<I>; 3],
+    /// Chooses the near and far plane of each slab. Taken from the inverse so that a direction
+    /// of −0.0 counts as negative, consistently with its −∞ inverse.
+    negative: [bool; 3],
+}
+
+impl<I: Isa> SlabLanes<I> {
+    #[inline(always)]
+    fn new(ray: &Ray) -> Self {
+        // Spelled out rather than mapped: a closure passed to `map` may be compiled outside the
+        // kernel, without its instructions.
+        let inverse = ray.direction.recip();
+        let far_inverse = inverse * (1.0 + 2.0 * gamma(3));
+        let (o, i, f) = (ray.origin, inverse, far_inverse);
+        SlabLanes {
+            origin: [R8::<I>::splat(o.x), R8::<I>::splat(o.y), R8::<I>::splat(o.z)],
+            inverse: [R8::<I>::splat(i.x), R8::<I>::splat(i.y), R8::<I>::splat(i.z)],
+            far_inverse: [R8::<I>::splat(f.x), R8::<I>::splat(f.y), R8::<I>::splat(f.z)],
+            negative: [inverse.x < 0.0, inverse.y < 0.0, inverse.z < 0.0],
+        }
+    }
+}
+
+/// The slab test of a node's eight boxes: each box's entry distance, and a bit per box the ray
+/// meets for some `t` in `[0, t_limit]`.
+///
+/// Conservative: it may report a hit the exact test would not, but never misses a box the
+/// ray really touches, which is what keeps traversal from losing primitives. Two details
+/// make that so. The far distance on each axis is widened by `1 + 2·gamma(3)` (pbrt-v4), which
+/// covers the rounding of the inverse, the subtraction and the multiplication; it is folded
+/// into the inverse once per ray, which adds one more rounding of `u`, still well inside the
+/// `6u` of the widening (`(1 − u)⁴·(1 + 2·gamma(3)) > 1`). And a zero direction component
+/// gives an infinite inverse, so an origin lying exactly on that slab's plane computes
+/// `0 · ∞ = NaN`; `max`/`min` keep their second operand for a NaN, so that slab then constrains
+/// nothing, i.e. the plane counts as inside the box, as a closed box should. An empty box
+/// (`min = +∞`, `max = −∞`) is never hit: its far distance is `−∞` on every axis.
+#[inline(always)]
+fn node_hits<I: Isa>(node: &BvhNode, ray: &SlabLanes<I>, t_limit: Real) -> (R8<I>, u32) {
+    let mut t_enter = R8::<I>::splat(0.0);
+    let mut t_exit = R8::<I>::splat(t_limit);
+    for axis in 0..3 {
+        let negative = ray.negative[axis];
+        let (near, far) = (&node.bounds[negative as usize][axis], &node.bounds[!negative as usize][axis]);
+        let t_near = (R8::<I>::load(near) - ray.origin[axis]) * ray.inverse[axis];
+        let t_far = (R8::<I>::load(far) - ray.origin[axis]) * ray.far_inverse[axis];
+        t_enter = t_near.max(t_enter);
+        t_exit = t_far.min(t_exit);
+    }
+    (t_enter, t_enter.le(t_exit).bits())
+}
+
+/// A key that sorts children by the distance at which the ray enters them (non-negative and
+/// never NaN, so the bits of the float order as it does) and carries the child's lane in its
+/// low bits. In `f64` the distance's three lowest bits make way for the lane: the order only
+/// decides how soon a child is visited, never which hit is found.
+#[inline(always)]
+fn sort_key(t: Real, lane: usize) -> u64 {
+    let bits = t.to_bits() as u64;
+    let key = if size_of::<Real>() == 4 { bits << 3 } else { bits & !7 };
+    key | lane as u64
+}
+
+/// Entries the traversal stack holds in place before it spills to the heap. Rays rarely need
+/// more than a few dozen, and a small frame keeps the kernels that do not traverse cheap.
+const INLINE_STACK: usize = 64;
+
+/// The traversal stack: `INLINE_STACK` entries inline and, unlike an array, not initialised
+/// (zeroing them for every ray would cost more than most rays push), then a vector for the
+/// deepest trees (at most `STACK_SIZE` entries in all), allocated only if ever needed.
+struct Stack {
+    entries: [MaybeUninit<Pending>; INLINE_STACK],
+    len: usize,
+    spilled: Vec<Pending>,
+}
+
+impl Stack {
+    #[inline(always)]
+    fn new() -> Self {
+        Stack { entries: [const { MaybeUninit::uninit() }; INLINE_STACK], len: 0, spilled: Vec::new() }
+    }
+
+    #[inline(always)]
+    fn push(&mut self, entry: Pending) {
+        if self.len < INLINE_STACK {
+            self.entries[self.len] = MaybeUninit::new(entry);
+            self.len += 1;
+        } else {
+            self.spill(entry);
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn spill(&mut self, entry: Pending) {
+        debug_assert!(self.spilled.len() + INLINE_STACK < STACK_SIZE);
+        self.spilled.push(entry);
+    }
+
+    #[inline(always)]
+    fn pop(&mut self) -> Option<Pending> {
+        if !self.spilled.is_empty() {
+            return self.spilled.pop();
+        }
+        if self.len == 0 {
+            return None;
+        }
+        self.len -= 1;
+        // SAFETY: entries below `len` were written by `push`.
+        Some(unsafe { self.entries[self.len].assume_init() })
+    }
+}
+
+/// Depth-first traversal with an explicit stack, nearest child first: each node's eight boxes
+/// are tested at once, the children hit are ordered by where the ray enters them, the nearest
+/// is visited next and the others wait on the stack with their entry distance. `visit(first,
+/// count, t_limit)` is called for each leaf reached; it may shrink `t_limit`, which prunes every
+/// box entered beyond it (a box entered exactly at the limit is still visited).
+///
+/// A kernel: compile it only inside one (see `crate::simd`).
+#[inline(always)]
+pub fn traverse<I: Isa>(
+    nodes: &[BvhNode],
+    ray: &Ray,
+    t_max: Real,
+    mut visit: impl FnMut(u32, u32, &mut Real) -> Visit,
+) {
+    if nodes.is_empty() || !(ray.origin.is_finite() && ray.direction.is_finite()) {
+        return;
+    }
+    let slab = SlabLanes::<I>::new(ray);
+    let mut t_limit = t_max;
+    let mut stack = Stack::new();
+    let mut current = Pending { t: 0.0, index: 0, count: 0 };
+    loop {
+        if current.count == 0 {
+            let node = &nodes[current.index as usize];
+            let (t_enter, hits) = node_hits::<I>(node, &slab, t_limit);
+            if hits != 0 {
+                let first = hits.trailing_zeros() as usize;
+                let rest = hits & (hits - 1);
+                if rest == 0 {
+                    current = Pending { t: 0.0, index: node.child[first], count: node.count[first] };
                     continue;
                 }
-            } else {
-                let first = current.index as usize;
-                for &prim in &self.prim_indices[first..first + current.count as usize] {
-                    if let Visit::Stop = visit(prim, &mut t_limit) {
-                        return;
+                let mut t = [0.0; WIDTH];
+                t_enter.store(&mut t);
+                let child = |lane: usize| Pending { t: t[lane], index: node.child[lane], count: node.count[lane] };
+                if rest & (rest - 1) == 0 {
+                    // Two children, the common case: the farther one waits.
+                    let second = rest.trailing_zeros() as usize;
+                    let (near, far) = if t[second] < t[first] { (second, first) } else { (first, second) };
+                    stack.push(child(far));
+                    current = child(near);
+                    continue;
+                }
+                // More: sort keys that order by entry distance and carry the lane, nearest first.
+                let mut keys = [0u64; WIDTH];
+                let mut len = 0;
+                let mut remaining = hits;
+                while remaining != 0 {
+                    let lane = remaining.trailing_zeros() as usize;
+                    remaining &= remaining - 1;
+                    let key = sort_key(t[lane], lane);
+                    let mut k = len;
+                    while k > 0 && keys[k - 1] > key {
+                        keys[k] = keys[k - 1];
+                        k -= 1;
                     }
+                    keys[k] = key;
+                    len += 1;
                 }
+                for &key in keys[1..len].iter().rev() {
+                    stack.push(child(key as usize & (WIDTH - 1)));
+                }
+                current = child(keys[0] as usize & (WIDTH - 1));
+                continue;
             }
-            loop {
-                let Some(pending) = stack.pop() else { return };
-                // The box was hit before `t_limit` shrank; entered beyond it, it holds nothing nearer.
-                if pending.t <= t_limit {
-                    current = pending;
-                    break;
-                }
+        } else if let Visit::Stop = visit(current.index, current.count, &mut t_limit) {
+            return;
+        }
+        loop {
+            let Some(pending) = stack.pop() else { return };
+            // The box was hit before `t_limit` shrank; entered beyond it, it holds nothing nearer.
+            if pending.t <= t_limit {
+                current = pending;
+                break;
             }
         }
     }
@@ -271,24 +485,24 @@ mod tests {
     }
 
     #[test]
-    fn node_is_two_cache_lines_with_f32() {
+    fn node_is_four_cache_lines_with_f32() {
         if size_of::<Real>() == 4 {
-            assert_eq!((size_of::<BvhNode>(), align_of::<BvhNode>()), (128, 64));
+            assert_eq!((size_of::<BvhNode>(), align_of::<BvhNode>()), (256, 64));
         }
     }
 
     #[test]
-    fn wide_nodes_have_two_to_four_children_and_keep_every_leaf() {
+    fn wide_nodes_have_two_to_eight_children_and_keep_every_leaf() {
         let points: Vec<Vec3> = (0..2000)
             .map(|i| Vec3::new((i * 37 % 101) as Real, (i * 11 % 13) as Real, (i % 7) as Real))
             .collect();
         let boxes = point_boxes(&points);
-        let (binary, _) = build::build(&boxes);
+        let (binary, _) = build::build(&boxes, LeafCost::PerPrimitive);
         let bvh = Bvh::build(&boxes);
         let binary_leaves = binary.iter().filter(|node| node.is_leaf()).count();
         assert_eq!(bvh.leaf_count(), binary_leaves);
         for node in &bvh.nodes {
-            let used = (0..WIDTH).filter(|&lane| node.min[0][lane] <= node.max[0][lane]).count();
+            let used = (0..WIDTH).filter(|&lane| node.bounds[0][0][lane] <= node.bounds[1][0][lane]).count();
             assert!((2..=WIDTH).contains(&used), "{used} children");
             assert!(node.count.iter().all(|&count| count <= 4));
         }

@@ -4,13 +4,15 @@
 use std::time::{Duration, Instant};
 
 use super::aabb::Aabb;
-use super::bvh::Bvh;
+use super::bvh::{Bvh, LeafCost, Visit, traverse};
 use super::triangle::{
-    TriangleHit, TriangleRay, face_normal, intersect_triangle, normalize, triangle_surface,
+    PackRay, TriangleHit, TrianglePack, face_normal, intersect_pack, lane_hit, normalize, triangle_surface,
 };
 use super::{Ray, SurfaceHit};
 use super::real::{Real, Vec3};
 pub use crate::build_error::MeshError;
+use crate::simd::{Isa, Kernel, dispatch};
+use rayon::prelude::*;
 
 /// The vertex normals a mesh is built with.
 #[derive(Clone, Debug)]
@@ -46,15 +48,19 @@ pub struct MeshHit {
 
 /// A triangle mesh ready for ray queries.
 ///
-/// Triangles are stored in BVH leaf order with their corner positions inline, so a leaf's
-/// triangles are adjacent in memory and testing one needs no index indirection. Normals that
-/// are zero or not finite (from the file, or averaged over degenerate or cancelling faces) are
-/// stored as zero; a triangle with any such corner is shaded with its geometric normal.
+/// Triangles are numbered in BVH leaf order. Each leaf's triangles are packed four to a
+/// [`TrianglePack`] (corner positions inline, one SIMD lane per triangle), so a leaf is tested
+/// with one packed test and no index indirection; the leaves point at their packs. The corners
+/// are also kept per triangle for shading. Normals that are zero or not finite (from the file,
+/// or averaged over degenerate or cancelling faces) are stored as zero; a triangle with any such
+/// corner is shaded with its geometric normal.
 #[derive(Clone, Debug)]
 pub struct Mesh {
     corners: Vec<[Vec3; 3]>,
     normal_indices: Vec<[u32; 3]>,
     normals: Vec<Vec3>,
+    packs: Vec<TrianglePack>,
+    /// Its leaves are runs of `packs`.
     bvh: Bvh,
     /// Kept for render statistics, which report BVH builds apart from OBJ parsing.
     bvh_build_time: Duration,
@@ -83,57 +89,98 @@ impl Mesh {
                 (unit, normal_triangles)
             }
         };
-        let corners_of = |[a, b, c]: [u32; 3]| {
-            [
-                positions[a as usize],
-                positions[b as usize],
-                positions[c as usize],
-            ]
-        };
-        let bounds: Vec<Aabb> = triangles
-            .iter()
-            .map(|&t| Aabb::from_points(corners_of(t)))
-            .collect();
+        let corners_of = |[a, b, c]: [u32; 3]| [positions[a as usize], positions[b as usize], positions[c as usize]];
         let build_start = Instant::now();
-        let (bvh, order) = Bvh::build(&bounds).into_leaf_order();
+        let bounds: Vec<Aabb> = triangles.par_iter().map(|&t| Aabb::from_points(corners_of(t))).collect();
+        let (mut bvh, order) = Bvh::build_for(&bounds, LeafCost::PerPackOfFour).into_leaf_order();
+        drop(bounds);
+        let corners: Vec<[Vec3; 3]> = order.par_iter().map(|&i| corners_of(triangles[i as usize])).collect();
+        let packs = pack_leaves(&mut bvh, &corners);
         let bvh_build_time = build_start.elapsed();
         Ok(Mesh {
-            corners: order
-                .iter()
-                .map(|&i| corners_of(triangles[i as usize]))
-                .collect(),
-            normal_indices: order.iter().map(|&i| normal_indices[i as usize]).collect(),
+            corners,
+            normal_indices: order.par_iter().map(|&i| normal_indices[i as usize]).collect(),
             normals,
+            packs,
             bvh,
             bvh_build_time,
         })
     }
 
-    /// The closest hit in `(0, t_max]`.
+    /// The closest hit in `(0, t_max]`. Of hits at the same `t`, the triangle with the smaller
+    /// index wins, so the hit does not depend on the order the BVH is traversed in.
     pub fn intersect(&self, ray: &Ray, t_max: Real) -> Option<MeshHit> {
-        let triangle_ray = TriangleRay::new(ray);
-        let mut closest = None;
-        self.bvh.closest(ray, t_max, |triangle, t_limit| {
-            let [p0, p1, p2] = self.corners[triangle as usize];
-            let hit = intersect_triangle(&triangle_ray, t_limit, p0, p1, p2)?;
-            closest = Some(MeshHit {
-                t: hit.t,
-                triangle,
-                barycentrics: [hit.b0, hit.b1, hit.b2],
-            });
-            Some(hit.t)
-        })?;
+        struct Closest<'a>(&'a Mesh, &'a Ray, Real);
+        impl Kernel for Closest<'_> {
+            type Output = Option<MeshHit>;
+            #[inline(always)]
+            fn run<I: Isa>(self) -> Option<MeshHit> {
+                self.0.closest_lanes::<I>(self.1, self.2)
+            }
+        }
+        dispatch(Closest(self, ray, t_max))
+    }
+
+    #[inline(always)]
+    fn closest_lanes<I: Isa>(&self, ray: &Ray, t_max: Real) -> Option<MeshHit> {
+        let pack_ray = PackRay::<I>::new(ray);
+        let mut closest: Option<MeshHit> = None;
+        traverse::<I>(self.bvh.nodes(), ray, t_max, |first, count, t_limit| {
+            for pack in &self.packs[first as usize..(first + count) as usize] {
+                let found = intersect_pack::<I>(pack, &pack_ray, *t_limit);
+                let mut lanes = found.lanes;
+                if lanes == 0 {
+                    continue;
+                }
+                let values = found.lanes();
+                while lanes != 0 {
+                    let lane = lanes.trailing_zeros() as usize;
+                    lanes &= lanes - 1;
+                    let (t, triangle) = (values[0][lane], pack.ids()[lane]);
+                    let nearer = match &closest {
+                        Some(best) => t < best.t || (t == best.t && triangle < best.triangle),
+                        None => true,
+                    };
+                    if nearer {
+                        let hit = lane_hit(&values, lane);
+                        *t_limit = t;
+                        closest = Some(MeshHit { t, triangle, barycentrics: [hit.b0, hit.b1, hit.b2] });
+                    }
+                }
+            }
+            Visit::Continue
+        });
         closest
     }
 
     /// Whether anything is hit in `(0, t_max]`; cheaper than [`Mesh::intersect`] because it
     /// stops at the first hit.
     pub fn occluded(&self, ray: &Ray, t_max: Real) -> bool {
-        let triangle_ray = TriangleRay::new(ray);
-        self.bvh.any(ray, t_max, |triangle, t_limit| {
-            let [p0, p1, p2] = self.corners[triangle as usize];
-            intersect_triangle(&triangle_ray, t_limit, p0, p1, p2).is_some()
-        })
+        struct Any<'a>(&'a Mesh, &'a Ray, Real);
+        impl Kernel for Any<'_> {
+            type Output = bool;
+            #[inline(always)]
+            fn run<I: Isa>(self) -> bool {
+                self.0.any_lanes::<I>(self.1, self.2)
+            }
+        }
+        dispatch(Any(self, ray, t_max))
+    }
+
+    #[inline(always)]
+    fn any_lanes<I: Isa>(&self, ray: &Ray, t_max: Real) -> bool {
+        let pack_ray = PackRay::<I>::new(ray);
+        let mut found = false;
+        traverse::<I>(self.bvh.nodes(), ray, t_max, |first, count, t_limit| {
+            let packs = &self.packs[first as usize..(first + count) as usize];
+            if packs.iter().any(|pack| intersect_pack::<I>(pack, &pack_ray, *t_limit).lanes != 0) {
+                found = true;
+                Visit::Stop
+            } else {
+                Visit::Continue
+            }
+        });
+        found
     }
 
     /// Point, error bound and normals of a hit returned by [`Mesh::intersect`].
@@ -173,10 +220,40 @@ impl Mesh {
         &self.bvh
     }
 
-    /// How long [`Mesh::new`] took to build the BVH (the rest of a load is reading the file).
+    /// How long [`Mesh::new`] took to build what rays are traced through: the triangles' boxes,
+    /// the BVH and the triangle packs (the rest of a load is reading the file, checking it and
+    /// the vertex normals).
     pub fn bvh_build_time(&self) -> Duration {
         self.bvh_build_time
     }
+}
+
+/// Packs each leaf's triangles (`corners` is in leaf order) four at a time, in leaf order, and
+/// points the leaf at its packs.
+fn pack_leaves(bvh: &mut Bvh, corners: &[[Vec3; 3]]) -> Vec<TrianglePack> {
+    let leaves = bvh.leaves();
+    // Where each leaf's packs start, by the leaf's first triangle.
+    let mut first_pack = vec![0u32; corners.len()];
+    let mut packed = 0;
+    for &(first, count) in &leaves {
+        first_pack[first as usize] = packed;
+        packed += count.div_ceil(4);
+    }
+    let packs = leaves
+        .par_iter()
+        .flat_map_iter(|&(first, count)| {
+            (first..first + count).step_by(4).map(move |start| {
+                let end = (start + 4).min(first + count);
+                let mut lanes = [(0, [Vec3::ZERO; 3]); 4];
+                for (lane, index) in (start..end).enumerate() {
+                    lanes[lane] = (index, corners[index as usize]);
+                }
+                TrianglePack::new(&lanes[..(end - start) as usize])
+            })
+        })
+        .collect();
+    bvh.remap_leaves(|first, count| (first_pack[first as usize], count.div_ceil(4)));
+    packs
 }
 
 fn validate(positions: &[Vec3], triangles: &[[u32; 3]]) -> Result<(), MeshError> {
@@ -235,18 +312,23 @@ fn validate_normal_indices(
 /// One unit normal per position, following [`VertexNormals::Averaged`]; zero where the sum
 /// cannot be normalised (no usable face, or faces cancelling out).
 fn averaged_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
+    // The face normals in parallel; their sums in triangle order, as always.
+    let faces: Vec<Option<Vec3>> = triangles
+        .par_iter()
+        .map(|corners| {
+            let [p0, p1, p2] = corners.map(|i| positions[i as usize]);
+            face_normal(p0, p1, p2)
+        })
+        .collect();
     let mut sums = vec![Vec3::ZERO; positions.len()];
-    for corners in triangles {
-        let [p0, p1, p2] = corners.map(|i| positions[i as usize]);
-        if let Some(normal) = face_normal(p0, p1, p2) {
+    for (corners, face) in triangles.iter().zip(faces) {
+        if let Some(normal) = face {
             for &vertex in corners {
                 sums[vertex as usize] += normal;
             }
         }
     }
-    sums.into_iter()
-        .map(|sum| normalize(sum).unwrap_or(Vec3::ZERO))
-        .collect()
+    sums.into_par_iter().map(|sum| normalize(sum).unwrap_or(Vec3::ZERO)).collect()
 }
 
 #[cfg(test)]

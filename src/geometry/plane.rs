@@ -2,7 +2,8 @@
 //! the BVH.
 
 use super::ray::{Ray, SurfaceHit};
-use super::real::{Real, Vec3, gamma};
+use super::real::{R8, Real, Vec3, gamma};
+use crate::simd::{Isa, Lanes, MaskOps};
 
 #[derive(Clone, Copy, Debug)]
 pub struct Plane {
@@ -22,13 +23,14 @@ impl Plane {
         Plane { normal: unit, offset: offset / length, shading_normal: unit }
     }
 
+    /// Where the ray meets the plane in `(0, t_max]`.
     pub fn intersect(&self, ray: &Ray, t_max: Real) -> Option<Real> {
         let denominator = self.normal.dot(ray.direction);
         if denominator == 0.0 {
             return None;
         }
         let t = (self.offset - self.normal.dot(ray.origin)) / denominator;
-        (t > 0.0 && t < t_max && t.is_finite()).then_some(t)
+        (t > 0.0 && t <= t_max && t.is_finite()).then_some(t)
     }
 
     /// The hit point is projected back onto the plane, which leaves an error proportional to the
@@ -41,6 +43,53 @@ impl Plane {
         let point_error = gamma(7) * (point.abs() + self.normal.abs() * self.offset.abs());
         SurfaceHit { t, point, point_error, geometric_normal: self.normal, shading_normal: self.shading_normal }
     }
+}
+
+/// Planes tested side by side in [`intersect_planes`].
+pub const PLANE_LANES: usize = 8;
+
+/// Up to eight planes side by side, one per SIMD lane.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(32))]
+pub struct PlanePack {
+    /// `normal[axis][lane]`.
+    normal: [[Real; PLANE_LANES]; 3],
+    offset: [Real; PLANE_LANES],
+    /// Bit per lane holding a plane (the others are padding, which no ray hits).
+    live: u32,
+}
+
+impl PlanePack {
+    /// Packs one to eight planes; the remaining lanes are padding.
+    pub fn new(planes: &[Plane]) -> PlanePack {
+        assert!((1..=PLANE_LANES).contains(&planes.len()), "a pack holds one to eight planes");
+        let mut pack = PlanePack { normal: [[0.0; PLANE_LANES]; 3], offset: [0.0; PLANE_LANES], live: 0 };
+        for (lane, plane) in planes.iter().enumerate() {
+            for axis in 0..3 {
+                pack.normal[axis][lane] = plane.normal[axis];
+            }
+            pack.offset[lane] = plane.offset;
+            pack.live |= 1 << lane;
+        }
+        pack
+    }
+}
+
+/// [`Plane::intersect`] on the lanes of `pack`, with the same operations in the same order: a
+/// bit per lane hit in `(0, t_max]`, and each lane's `t`.
+///
+/// A kernel: compile it only inside one (see `crate::simd`).
+#[inline(always)]
+pub fn intersect_planes<I: Isa>(pack: &PlanePack, ray: &Ray, t_max: Real) -> (u32, R8<I>) {
+    let splat = R8::<I>::splat;
+    let (o, d) = (ray.origin, ray.direction);
+    let (nx, ny, nz) = (R8::<I>::load(&pack.normal[0]), R8::<I>::load(&pack.normal[1]), R8::<I>::load(&pack.normal[2]));
+    let denominator = nx * splat(d.x) + ny * splat(d.y) + nz * splat(d.z);
+    let height = nx * splat(o.x) + ny * splat(o.y) + nz * splat(o.z);
+    let t = (R8::<I>::load(&pack.offset) - height) / denominator;
+    let zero = splat(0.0);
+    let hit = t.gt(zero).and(t.le(splat(t_max))).and(t.abs().lt(splat(Real::INFINITY))).and_not(denominator.eq(zero));
+    (hit.bits() & pack.live, t)
 }
 
 #[cfg(test)]

@@ -3,7 +3,8 @@
 
 use super::aabb::Aabb;
 use super::ray::{Ray, SurfaceHit};
-use super::real::{Real, Vec3, gamma};
+use super::real::{R8, Real, Vec3, gamma};
+use crate::simd::{Isa, Lanes, MaskOps};
 
 #[derive(Clone, Copy, Debug)]
 pub struct Sphere {
@@ -17,7 +18,7 @@ impl Sphere {
         Aabb { min: self.center - r, max: self.center + r }
     }
 
-    /// The nearest `t` in `(0, t_max)` where the ray meets the sphere.
+    /// The nearest `t` in `(0, t_max]` where the ray meets the sphere.
     ///
     /// The textbook `b² − 4ac` cancels catastrophically when the ray passes far from the centre
     /// relative to the radius (or the sphere is tiny and far away); computing the discriminant
@@ -48,7 +49,10 @@ impl Sphere {
         if t0 > t1 {
             std::mem::swap(&mut t0, &mut t1);
         }
-        [t0, t1].into_iter().find(|&t| t > 0.0 && t < t_max && t.is_finite())
+        // The nearer root in front of the origin, else the farther one: the first root with
+        // `t > 0` (finite), which counts when it is within `t_max`. `SpherePack` does the same.
+        let t = if t0 > 0.0 && t0.is_finite() { t0 } else { t1 };
+        (t > 0.0 && t <= t_max && t.is_finite()).then_some(t)
     }
 
     /// The hit point is re-projected onto the sphere so that its error no longer grows with the
@@ -63,6 +67,116 @@ impl Sphere {
         let point_error = gamma(5) * relative.abs() + gamma(1) * point.abs();
         SurfaceHit { t, point, point_error, geometric_normal: normal, shading_normal: normal }
     }
+}
+
+/// Spheres tested side by side in [`intersect_spheres`].
+pub const SPHERE_LANES: usize = 8;
+
+/// Up to eight spheres side by side, one per SIMD lane, for [`intersect_spheres`].
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(32))]
+pub struct SpherePack {
+    /// `center[axis][lane]`.
+    center: [[Real; SPHERE_LANES]; 3],
+    radius: [Real; SPHERE_LANES],
+    /// Each lane's sphere, as the caller numbers it.
+    ids: [u32; SPHERE_LANES],
+    /// Bit per lane holding a sphere that can be hit: not padding, a positive radius.
+    live: u32,
+}
+
+impl SpherePack {
+    /// Packs one to eight `(id, sphere)`; the remaining lanes are padding that no ray hits.
+    pub fn new(spheres: &[(u32, Sphere)]) -> SpherePack {
+        assert!((1..=SPHERE_LANES).contains(&spheres.len()), "a pack holds one to eight spheres");
+        let mut pack = SpherePack {
+            center: [[0.0; SPHERE_LANES]; 3],
+            radius: [0.0; SPHERE_LANES],
+            ids: [u32::MAX; SPHERE_LANES],
+            live: 0,
+        };
+        for (lane, (id, sphere)) in spheres.iter().enumerate() {
+            for axis in 0..3 {
+                pack.center[axis][lane] = sphere.center[axis];
+            }
+            pack.radius[lane] = sphere.radius;
+            pack.ids[lane] = *id;
+            if sphere.radius > 0.0 {
+                pack.live |= 1 << lane;
+            }
+        }
+        pack
+    }
+
+    pub fn ids(&self) -> &[u32; SPHERE_LANES] {
+        &self.ids
+    }
+}
+
+/// The per-ray part of [`intersect_spheres`], splatted across the lanes.
+pub struct SphereRay<I: Isa> {
+    origin: [R8<I>; 3],
+    direction: [R8<I>; 3],
+    /// `|d|²`, `2·|d|²` and `4·|d|²`, as [`Sphere::intersect`] computes them.
+    a: R8<I>,
+    two_a: R8<I>,
+    four_a: R8<I>,
+    /// Zero-length directions hit nothing.
+    moving: bool,
+}
+
+impl<I: Isa> SphereRay<I> {
+    #[inline(always)]
+    pub fn new(ray: &Ray) -> Self {
+        let (o, d) = (ray.origin, ray.direction);
+        let a = d.length_squared();
+        SphereRay {
+            origin: [R8::<I>::splat(o.x), R8::<I>::splat(o.y), R8::<I>::splat(o.z)],
+            direction: [R8::<I>::splat(d.x), R8::<I>::splat(d.y), R8::<I>::splat(d.z)],
+            a: R8::<I>::splat(a),
+            two_a: R8::<I>::splat(2.0 * a),
+            four_a: R8::<I>::splat(4.0 * a),
+            moving: a != 0.0,
+        }
+    }
+}
+
+/// [`Sphere::intersect`] on the lanes of `pack`, with the same operations in the same order:
+/// a bit per lane hit in `(0, t_max]`, and each lane's `t`.
+///
+/// A kernel: compile it only inside one (see `crate::simd`).
+#[inline(always)]
+pub fn intersect_spheres<I: Isa>(pack: &SpherePack, ray: &SphereRay<I>, t_max: Real) -> (u32, R8<I>) {
+    let splat = R8::<I>::splat;
+    let zero = splat(0.0);
+    if !ray.moving {
+        return (0, zero);
+    }
+    let [dx, dy, dz] = ray.direction;
+    let ox = ray.origin[0] - R8::<I>::load(&pack.center[0]);
+    let oy = ray.origin[1] - R8::<I>::load(&pack.center[1]);
+    let oz = ray.origin[2] - R8::<I>::load(&pack.center[2]);
+    let radius = R8::<I>::load(&pack.radius);
+    let b = splat(2.0) * (dx * ox + dy * oy + dz * oz);
+    let c = (ox * ox + oy * oy + oz * oz) - radius * radius;
+    let along = b / ray.two_a;
+    let (px, py, pz) = (ox - dx * along, oy - dy * along, oz - dz * along);
+    let closest_approach = (px * px + py * py + pz * pz).sqrt();
+    let discriminant = ray.four_a * (radius + closest_approach) * (radius - closest_approach);
+    let root = discriminant.sqrt();
+    let q = R8::<I>::select(b.lt(zero), splat(-0.5) * (b - root), splat(-0.5) * (b + root));
+    let (r0, r1) = (q / ray.a, c / q);
+    let swap = r0.gt(r1);
+    let (t0, t1) = (R8::<I>::select(swap, r1, r0), R8::<I>::select(swap, r0, r1));
+    let infinity = splat(Real::INFINITY);
+    let t = R8::<I>::select(t0.gt(zero).and(t0.abs().lt(infinity)), t0, t1);
+    let hit = t
+        .gt(zero)
+        .and(t.le(splat(t_max)))
+        .and(t.abs().lt(infinity))
+        .and_not(discriminant.lt(zero))
+        .and_not(q.eq(zero));
+    (hit.bits() & pack.live, t)
 }
 
 #[cfg(test)]

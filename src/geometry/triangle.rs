@@ -10,7 +10,8 @@
 use glam::Vec3Swizzles;
 
 use super::{Ray, SurfaceHit};
-use super::real::{Real, Vec3, gamma};
+use super::real::{R4, Real, Vec3, gamma, narrow4, wide4};
+use crate::simd::{Isa, Lanes, MaskOps};
 
 /// The per-ray part of the test: which axis becomes z, and the shear that makes the ray
 /// direction (0, 0, 1). Computing it once per ray saves that work for every triangle tested.
@@ -108,18 +109,17 @@ pub fn intersect_triangle(
     let z = Vec3::new(p0t.z, p1t.z, p2t.z) * ray.shear.z;
     let t_scaled = e0 * z.x + e1 * z.y + e2 * z.z;
     // Written so that a NaN determinant (degenerate ray direction) falls through to a miss.
-    let in_range = if det > 0.0 {
-        t_scaled > 0.0 && t_scaled <= t_max * det
-    } else if det < 0.0 {
-        t_scaled < 0.0 && t_scaled >= t_max * det
-    } else {
-        false
-    };
-    if !in_range {
+    let in_front = (det > 0.0 && t_scaled > 0.0) || (det < 0.0 && t_scaled < 0.0);
+    if !in_front {
         return None;
     }
     let inv_det = 1.0 / det;
     let t = t_scaled * inv_det;
+    // Compared as computed, not as `t_scaled` against `t_max · det`: whether a hit counts then
+    // depends on its `t` alone, as the packed test and the closest-hit tie rule need.
+    if t.is_nan() || t > t_max {
+        return None;
+    }
 
     // pbrt's bounds, with one correction: the shear's x and y terms are bounded by the
     // *unscaled* z (|shear.x|, |shear.y| ≤ 1), while t uses z scaled by 1/d.z. pbrt uses the
@@ -147,6 +147,161 @@ pub fn intersect_triangle(
         b1: e1 * inv_det,
         b2: e2 * inv_det,
     })
+}
+
+/// Four triangles side by side, one per SIMD lane, for [`intersect_pack`]: the same watertight
+/// test as [`intersect_triangle`], operation for operation, on four triangles at once.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(16))]
+pub struct TrianglePack {
+    /// `corners[vertex][axis][lane]`.
+    corners: [[[Real; 4]; 3]; 3],
+    /// Each lane's triangle, as the mesh numbers it.
+    ids: [u32; 4],
+    /// Bit per lane holding a triangle that can be hit: not padding, not of zero area.
+    live: u32,
+}
+
+impl TrianglePack {
+    /// Packs one to four `(id, corners)`; the remaining lanes are padding that no ray hits.
+    /// Zero-area triangles are kept (their ids stay in place) but never hit, as in
+    /// [`intersect_triangle`].
+    pub fn new(triangles: &[(u32, [Vec3; 3])]) -> TrianglePack {
+        assert!((1..=4).contains(&triangles.len()), "a pack holds one to four triangles");
+        let mut pack = TrianglePack { corners: [[[0.0; 4]; 3]; 3], ids: [u32::MAX; 4], live: 0 };
+        for (lane, &(id, [p0, p1, p2])) in triangles.iter().enumerate() {
+            for (vertex, p) in [p0, p1, p2].into_iter().enumerate() {
+                for axis in 0..3 {
+                    pack.corners[vertex][axis][lane] = p[axis];
+                }
+            }
+            pack.ids[lane] = id;
+            if (p2 - p0).cross(p1 - p0).length_squared() != 0.0 {
+                pack.live |= 1 << lane;
+            }
+        }
+        pack
+    }
+
+    pub fn ids(&self) -> &[u32; 4] {
+        &self.ids
+    }
+}
+
+/// [`TriangleRay`] splatted across the lanes of a pack test.
+pub struct PackRay<I: Isa> {
+    /// Which axes become x, y and z (the permutation of [`TriangleRay`]).
+    axes: [usize; 3],
+    /// The origin's permuted components.
+    origin: [R4<I>; 3],
+    shear: [R4<I>; 3],
+}
+
+impl<I: Isa> PackRay<I> {
+    #[inline(always)]
+    pub fn new(ray: &Ray) -> Self {
+        let triangle_ray = TriangleRay::new(ray);
+        let axes = match triangle_ray.axis_z {
+            0 => [1, 2, 0],
+            1 => [2, 0, 1],
+            _ => [0, 1, 2],
+        };
+        let shear = triangle_ray.shear;
+        PackRay {
+            axes,
+            origin: [
+                R4::<I>::splat(ray.origin[axes[0]]),
+                R4::<I>::splat(ray.origin[axes[1]]),
+                R4::<I>::splat(ray.origin[axes[2]]),
+            ],
+            shear: [R4::<I>::splat(shear.x), R4::<I>::splat(shear.y), R4::<I>::splat(shear.z)],
+        }
+    }
+}
+
+/// What [`intersect_pack`] found: the lanes hit within the limit, and per lane the values a hit
+/// is made of (`t`, and the edge functions and inverse determinant its barycentrics come from).
+pub struct PackHits<I: Isa> {
+    /// Bit per lane hit in `(0, t_max]`.
+    pub lanes: u32,
+    t: R4<I>,
+    edges: [R4<I>; 3],
+    inv_det: R4<I>,
+}
+
+impl<I: Isa> PackHits<I> {
+    /// What each lane's hit is made of: `t`, the three edge functions and the inverse
+    /// determinant; meaningful for `lanes` only.
+    #[inline(always)]
+    pub fn lanes(&self) -> [[Real; 4]; 5] {
+        let mut values = [[0.0; 4]; 5];
+        self.t.store(&mut values[0]);
+        self.edges[0].store(&mut values[1]);
+        self.edges[1].store(&mut values[2]);
+        self.edges[2].store(&mut values[3]);
+        self.inv_det.store(&mut values[4]);
+        values
+    }
+}
+
+/// Lane `lane` of [`PackHits::lanes`], as [`intersect_triangle`] would report it.
+#[inline(always)]
+pub fn lane_hit(values: &[[Real; 4]; 5], lane: usize) -> TriangleHit {
+    let inv_det = values[4][lane];
+    TriangleHit { t: values[0][lane], b0: values[1][lane] * inv_det, b1: values[2][lane] * inv_det, b2: values[3][lane] * inv_det }
+}
+
+/// [`intersect_triangle`] on the four lanes of `pack`, with the same operations in the same
+/// order, so that each lane's `t` and barycentrics are bit for bit those of the one-triangle test.
+///
+/// A kernel: compile it only inside one (see `crate::simd`).
+#[inline(always)]
+pub fn intersect_pack<I: Isa>(pack: &TrianglePack, ray: &PackRay<I>, t_max: Real) -> PackHits<I> {
+    let [kx, ky, kz] = ray.axes;
+    let vertex = |v: usize| {
+        let corner = &pack.corners[v];
+        let qx = R4::<I>::load(&corner[kx]) - ray.origin[0];
+        let qy = R4::<I>::load(&corner[ky]) - ray.origin[1];
+        let qz = R4::<I>::load(&corner[kz]) - ray.origin[2];
+        [qx + ray.shear[0] * qz, qy + ray.shear[1] * qz, qz]
+    };
+    let (p0, p1, p2) = (vertex(0), vertex(1), vertex(2));
+    let edge = |a: &[R4<I>; 3], b: &[R4<I>; 3]| {
+        narrow4::<I>(wide4::<I>(a[0]) * wide4::<I>(b[1]) - wide4::<I>(a[1]) * wide4::<I>(b[0]))
+    };
+    let (e0, e1, e2) = (edge(&p1, &p2), edge(&p2, &p0), edge(&p0, &p1));
+    let zero = R4::<I>::splat(0.0);
+    let negative = e0.lt(zero).or(e1.lt(zero)).or(e2.lt(zero));
+    let positive = e0.gt(zero).or(e1.gt(zero)).or(e2.gt(zero));
+    let det = e0 + e1 + e2;
+    let shear_z = ray.shear[2];
+    let (z0, z1, z2) = (p0[2] * shear_z, p1[2] * shear_z, p2[2] * shear_z);
+    let t_scaled = e0 * z0 + e1 * z1 + e2 * z2;
+    let in_front = det.gt(zero).and(t_scaled.gt(zero)).or(det.lt(zero).and(t_scaled.lt(zero)));
+    let inv_det = R4::<I>::splat(1.0) / det;
+    let t = t_scaled * inv_det;
+    let splat = R4::<I>::splat;
+    // Most packs are missed by every lane; the error bound below is only needed for the others.
+    let candidates = in_front.and_not(negative.and(positive)).and(t.le(splat(t_max)));
+    if candidates.bits() & pack.live == 0 {
+        return PackHits { lanes: 0, t, edges: [e0, e1, e2], inv_det };
+    }
+
+    let max3 = |a: R4<I>, b: R4<I>, c: R4<I>| a.abs().max(b.abs().max(c.abs()));
+    let max_zt = max3(z0, z1, z2);
+    let max_unscaled_zt = max3(p0[2], p1[2], p2[2]);
+    let max_xt = max3(p0[0], p1[0], p2[0]);
+    let max_yt = max3(p0[1], p1[1], p2[1]);
+    let delta_z = splat(gamma(3)) * max_zt;
+    let delta_x = splat(gamma(5)) * (max_xt + max_unscaled_zt);
+    let delta_y = splat(gamma(5)) * (max_yt + max_unscaled_zt);
+    let delta_e = splat(2.0) * (splat(gamma(2)) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
+    let max_e = max3(e0, e1, e2);
+    let delta_t =
+        splat(3.0) * (splat(gamma(3)) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
+
+    let hit = candidates.and_not(t.le(delta_t));
+    PackHits { lanes: hit.bits() & pack.live, t, edges: [e0, e1, e2], inv_det }
 }
 
 /// Describes the hit surface for shading and for spawning secondary rays.

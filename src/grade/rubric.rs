@@ -13,7 +13,7 @@ use super::integrity::{Integrity, integrity};
 use crate::case::{self, AssignmentOptions, Case, LoadOptions, MAX_BOUNCES, load_assignment_scene};
 use crate::fault::Fault;
 use crate::image_size::{MAX_IMAGE_SIZE, SizeLimit, check_side};
-use crate::located_toml::{self, Doc, Field, SourceLocation, Table, suggest};
+use crate::located_toml::{self, Doc, Field, ReadError, SourceLocation, Table, suggest};
 use crate::named_enum::NamedEnum;
 use crate::named_enum::named_enum;
 
@@ -121,10 +121,7 @@ const SCENE_ONLY_KEYS: &[&str] = &["bounces", "shadows", "jitter", "filter"];
 type Result<T> = std::result::Result<T, RubricError>;
 
 pub fn load_rubric(path: &Path) -> Result<Rubric> {
-    let source = std::fs::read_to_string(path).map_err(|source| RubricError::Read {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let source = ReadError::read_text(path, "the rubric")?;
     parse_rubric(&source, path)
 }
 

@@ -23,7 +23,7 @@ use std::path::Path;
 use toml::Spanned;
 use toml::de::DeTable;
 
-pub use self::error::LocatedError;
+pub use self::error::{LocatedError, ReadError};
 pub use self::location::SourceLocation;
 pub(crate) use self::reader::{Field, Table};
 pub(crate) use self::suggest::suggest;

@@ -1,3 +1,17 @@
 //! `precision = "f64"`: every position, direction, error bound and colour in double precision.
 
 instantiate!(f64, glam::DVec2, glam::DVec3, glam::DMat3, glam::DMat4);
+
+/// Lanes of `Real` for the SIMD kernels (`crate::simd`); edge functions are already in `f64`.
+pub type R4<I> = <I as crate::simd::Isa>::F64x4;
+pub type R8<I> = <I as crate::simd::Isa>::F64x8;
+
+#[inline(always)]
+pub fn wide4<I: crate::simd::Isa>(x: R4<I>) -> I::F64x4 {
+    x
+}
+
+#[inline(always)]
+pub fn narrow4<I: crate::simd::Isa>(x: I::F64x4) -> R4<I> {
+    x
+}

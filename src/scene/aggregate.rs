@@ -1,20 +1,40 @@
-//! All of a scene's geometry: bounded objects under a BVH, infinite planes beside it.
+//! All of a scene's geometry: a handful of plain spheres tested side by side, infinite planes,
+//! and everything else under a BVH.
 
-use super::object::{Object, ShapeHit};
-use super::geometry::bvh::Bvh;
-use super::geometry::plane::Plane;
+use super::geometry::aabb::{Aabb, SlabRay};
+use super::geometry::bvh::{Bvh, LeafCost, Visit, traverse};
+use super::geometry::plane::{PLANE_LANES, Plane, PlanePack, intersect_planes};
+use super::geometry::sphere::{SPHERE_LANES, SphereRay, SpherePack, intersect_spheres};
 use super::geometry::{Ray, SurfaceHit};
+use super::object::{Object, Shape, ShapeHit};
 use super::real::Real;
+use crate::simd::{Isa, Kernel, Lanes, dispatch};
 
-/// Below this many objects a linear scan is cheaper than a BVH, and a scene of one sphere pays
-/// for no tree at all.
-const LINEAR_SCAN_LIMIT: usize = 4;
+/// Up to this many untransformed spheres are tested on every ray, side by side, which costs
+/// less than the box tests of a tree; more go into the tree with everything else.
+const SPHERE_PACK_LIMIT: usize = SPHERE_LANES;
 
 #[derive(Debug)]
 pub struct Aggregate {
+    /// In the scene's order, which is also the order that breaks ties (see [`Aggregate::intersect`]).
     objects: Vec<Object>,
-    bvh: Option<Bvh>,
     planes: Vec<(Plane, u32)>,
+    /// The planes side by side, in order.
+    plane_packs: Vec<PlanePack>,
+    /// The spheres tested side by side: untransformed, and no more than `SPHERE_PACK_LIMIT`.
+    spheres: Vec<SpherePack>,
+    /// The other objects.
+    rest: Rest,
+}
+
+#[derive(Debug)]
+enum Rest {
+    Nothing,
+    /// A lone object, tested directly; behind its world box when it has a transform, since the
+    /// box test costs less than moving the ray into the object's space.
+    One { object: u32, bounds: Option<Aabb> },
+    /// A tree whose leaves hold positions in `objects`: object indices in the tree's leaf order.
+    Tree { bvh: Bvh, objects: Vec<u32> },
 }
 
 /// The closest surface a ray met, in world space.
@@ -24,78 +44,208 @@ pub struct Intersection {
     pub material: u32,
 }
 
-enum Closest {
-    Object(usize, ShapeHit),
+#[derive(Clone, Copy)]
+enum Found {
+    Object(u32, ShapeHit),
     Plane(usize, Real),
+}
+
+/// The nearest candidate so far. Of candidates at the same `t` the smaller id wins: objects in
+/// the scene's order, then planes, so that the hit never depends on the order of the tests.
+struct Closest {
+    t: Real,
+    id: u32,
+    found: Option<Found>,
+}
+
+impl Closest {
+    #[inline(always)]
+    fn offer(&mut self, t: Real, id: u32, found: Found) -> bool {
+        let nearer = t < self.t || (t == self.t && id < self.id);
+        if nearer {
+            (self.t, self.id, self.found) = (t, id, Some(found));
+        }
+        nearer
+    }
 }
 
 impl Aggregate {
     pub fn new(objects: Vec<Object>, planes: Vec<(Plane, u32)>) -> Aggregate {
-        let bvh = (objects.len() > LINEAR_SCAN_LIMIT)
-            .then(|| Bvh::build(&objects.iter().map(Object::bounds).collect::<Vec<_>>()));
-        Aggregate { objects, bvh, planes }
+        let plain_spheres: Vec<(u32, _)> = objects
+            .iter()
+            .enumerate()
+            .filter_map(|(index, object)| match (&object.shape, &object.transform) {
+                (Shape::Sphere(sphere), None) => Some((index as u32, *sphere)),
+                _ => None,
+            })
+            .collect();
+        let packed = plain_spheres.len() <= SPHERE_PACK_LIMIT;
+        let spheres = if packed { plain_spheres.chunks(SPHERE_LANES).map(SpherePack::new).collect() } else { Vec::new() };
+        let others: Vec<u32> = (0..objects.len() as u32)
+            .filter(|&index| {
+                let object = &objects[index as usize];
+                !(packed && matches!((&object.shape, &object.transform), (Shape::Sphere(_), None)))
+            })
+            .collect();
+        let rest = match others.as_slice() {
+            [] => Rest::Nothing,
+            &[object] => {
+                let lone = &objects[object as usize];
+                Rest::One { object, bounds: lone.transform.is_some().then(|| lone.bounds()) }
+            }
+            _ => {
+                let bounds: Vec<Aabb> = others.iter().map(|&index| objects[index as usize].bounds()).collect();
+                let bvh = Bvh::build_for(&bounds, LeafCost::Single);
+                let in_leaf_order = bvh.prim_indices().iter().map(|&k| others[k as usize]).collect();
+                Rest::Tree { bvh, objects: in_leaf_order }
+            }
+        };
+        let plane_list: Vec<Plane> = planes.iter().map(|(plane, _)| *plane).collect();
+        let plane_packs = plane_list.chunks(PLANE_LANES).map(PlanePack::new).collect();
+        Aggregate { objects, planes, plane_packs, spheres, rest }
     }
 
     pub fn objects(&self) -> &[Object] {
         &self.objects
     }
 
-    /// The infinite planes, tested beside the BVH, with their materials.
+    /// The infinite planes and their materials.
     pub fn planes(&self) -> &[(Plane, u32)] {
         &self.planes
     }
 
+    /// The tree over the objects that are neither planes nor a handful of plain spheres, when
+    /// there are at least two of them.
     pub fn bvh(&self) -> Option<&Bvh> {
-        self.bvh.as_ref()
+        match &self.rest {
+            Rest::Tree { bvh, .. } => Some(bvh),
+            _ => None,
+        }
     }
 
+    /// The closest surface along the ray. Of surfaces hit at exactly the same `t`, the object
+    /// listed first in the scene wins, and objects win over planes.
     pub fn intersect(&self, ray: &Ray) -> Option<Intersection> {
-        let mut closest = None;
-        let mut t_max = Real::INFINITY;
-        for (index, (plane, _)) in self.planes.iter().enumerate() {
-            if let Some(t) = plane.intersect(ray, t_max) {
-                t_max = t;
-                closest = Some(Closest::Plane(index, t));
+        struct Nearest<'a>(&'a Aggregate, &'a Ray);
+        impl Kernel for Nearest<'_> {
+            type Output = Option<Found>;
+            #[inline(always)]
+            fn run<I: Isa>(self) -> Option<Found> {
+                self.0.closest_lanes::<I>(self.1)
             }
         }
-        let mut test = |index: u32, t_max: Real| {
-            let hit = self.objects[index as usize].intersect(ray, t_max)?;
-            closest = Some(Closest::Object(index as usize, hit));
-            Some(hit.t())
-        };
-        match &self.bvh {
-            Some(bvh) => {
-                bvh.closest(ray, t_max, &mut test);
-            }
-            None => {
-                for index in 0..self.objects.len() as u32 {
-                    if let Some(t) = test(index, t_max) {
-                        t_max = t;
-                    }
-                }
-            }
-        }
-        Some(match closest? {
-            Closest::Object(index, hit) => {
-                let object = &self.objects[index];
+        Some(match dispatch(Nearest(self, ray))? {
+            Found::Object(index, hit) => {
+                let object = &self.objects[index as usize];
                 Intersection { surface: object.surface(ray, &hit), material: object.material }
             }
-            Closest::Plane(index, t) => {
+            Found::Plane(index, t) => {
                 let (plane, material) = &self.planes[index];
                 Intersection { surface: plane.surface(ray, t), material: *material }
             }
         })
     }
 
+    #[inline(always)]
+    fn closest_lanes<I: Isa>(&self, ray: &Ray) -> Option<Found> {
+        let mut closest = Closest { t: Real::INFINITY, id: u32::MAX, found: None };
+        if !self.spheres.is_empty() {
+            let sphere_ray = SphereRay::<I>::new(ray);
+            for pack in &self.spheres {
+                let (mut lanes, t) = intersect_spheres::<I>(pack, &sphere_ray, closest.t);
+                if lanes != 0 {
+                    let mut t_lanes = [0.0; SPHERE_LANES];
+                    t.store(&mut t_lanes);
+                    while lanes != 0 {
+                        let lane = lanes.trailing_zeros() as usize;
+                        lanes &= lanes - 1;
+                        let id = pack.ids()[lane];
+                        closest.offer(t_lanes[lane], id, Found::Object(id, ShapeHit::Sphere(t_lanes[lane])));
+                    }
+                }
+            }
+        }
+        let plane_ids = self.objects.len() as u32;
+        for (k, pack) in self.plane_packs.iter().enumerate() {
+            let (mut lanes, t) = intersect_planes::<I>(pack, ray, closest.t);
+            if lanes != 0 {
+                let mut t_lanes = [0.0; PLANE_LANES];
+                t.store(&mut t_lanes);
+                while lanes != 0 {
+                    let lane = lanes.trailing_zeros() as usize;
+                    lanes &= lanes - 1;
+                    let index = k * PLANE_LANES + lane;
+                    closest.offer(t_lanes[lane], plane_ids + index as u32, Found::Plane(index, t_lanes[lane]));
+                }
+            }
+        }
+        match &self.rest {
+            Rest::Nothing => {}
+            Rest::One { object, bounds } => {
+                if bounds.is_none_or(|bounds| bounds.hit_by(&SlabRay::new(ray), closest.t))
+                    && let Some(hit) = self.objects[*object as usize].intersect(ray, closest.t)
+                {
+                    closest.offer(hit.t(), *object, Found::Object(*object, hit));
+                }
+            }
+            Rest::Tree { bvh, objects } => {
+                traverse::<I>(bvh.nodes(), ray, closest.t, |first, count, t_limit| {
+                    for &index in &objects[first as usize..(first + count) as usize] {
+                        if let Some(hit) = self.objects[index as usize].intersect(ray, *t_limit) {
+                            closest.offer(hit.t(), index, Found::Object(index, hit));
+                            *t_limit = closest.t;
+                        }
+                    }
+                    Visit::Continue
+                });
+            }
+        }
+        closest.found
+    }
+
     /// Whether anything blocks the ray before `t_max`; stops at the first blocker found.
     pub fn occluded(&self, ray: &Ray, t_max: Real) -> bool {
-        if self.planes.iter().any(|(plane, _)| plane.intersect(ray, t_max).is_some()) {
+        struct Blocked<'a>(&'a Aggregate, &'a Ray, Real);
+        impl Kernel for Blocked<'_> {
+            type Output = bool;
+            #[inline(always)]
+            fn run<I: Isa>(self) -> bool {
+                self.0.any_lanes::<I>(self.1, self.2)
+            }
+        }
+        dispatch(Blocked(self, ray, t_max))
+    }
+
+    #[inline(always)]
+    fn any_lanes<I: Isa>(&self, ray: &Ray, t_max: Real) -> bool {
+        if !self.spheres.is_empty() {
+            let sphere_ray = SphereRay::<I>::new(ray);
+            if self.spheres.iter().any(|pack| intersect_spheres::<I>(pack, &sphere_ray, t_max).0 != 0) {
+                return true;
+            }
+        }
+        if self.plane_packs.iter().any(|pack| intersect_planes::<I>(pack, ray, t_max).0 != 0) {
             return true;
         }
-        let test = |index: u32, t_max: Real| self.objects[index as usize].occluded(ray, t_max);
-        match &self.bvh {
-            Some(bvh) => bvh.any(ray, t_max, test),
-            None => (0..self.objects.len() as u32).any(|index| test(index, t_max)),
+        match &self.rest {
+            Rest::Nothing => false,
+            Rest::One { object, bounds } => {
+                bounds.is_none_or(|bounds| bounds.hit_by(&SlabRay::new(ray), t_max))
+                    && self.objects[*object as usize].occluded(ray, t_max)
+            }
+            Rest::Tree { bvh, objects } => {
+                let mut blocked = false;
+                traverse::<I>(bvh.nodes(), ray, t_max, |first, count, t_limit| {
+                    let leaf = &objects[first as usize..(first + count) as usize];
+                    if leaf.iter().any(|&index| self.objects[index as usize].occluded(ray, *t_limit)) {
+                        blocked = true;
+                        Visit::Stop
+                    } else {
+                        Visit::Continue
+                    }
+                });
+                blocked
+            }
         }
     }
 }

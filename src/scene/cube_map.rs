@@ -2,19 +2,29 @@
 //! (docs/ARCHITECTURE.md, "Cube maps"): texel row 0 is the PNG's top row, faces chosen by the
 //! largest component, bilinear weights with edge-clamped indices.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
+use image::ImageFormat;
 use rayon::prelude::*;
 
 use super::real::{Color, Real, Vec3};
 pub use crate::build_error::CubeMapError;
 
-/// One face: linear texel values `byte / 255` (the reference applies no gamma), row 0 at the top.
+/// One face: a PNG read and checked at load, decoded when a ray first looks at it.
+///
+/// Scenes rarely see all six faces (the course's scene 7 sees two), and decoding is most of
+/// what a cube map costs, so a face no ray reaches is never decoded. Everything that can be
+/// checked without decoding is checked at load (the file, its PNG structure and every chunk's
+/// CRC, its size), so a broken file is still an error before anything is rendered.
 #[derive(Debug)]
 struct Face {
+    path: PathBuf,
+    png: Vec<u8>,
     width: usize,
     height: usize,
-    texels: Vec<[Real; 3]>,
+    /// Byte values row by row, row 0 at the top; or why the data could not be decoded.
+    texels: OnceLock<Result<Vec<[u8; 3]>, String>>,
 }
 
 #[derive(Debug)]
@@ -31,12 +41,18 @@ const DOWN: usize = 3;
 const FRONT: usize = 4;
 const BACK: usize = 5;
 
+/// Linear texel values, `byte / 255` (the reference applies no gamma), computed once.
+fn byte_values() -> &'static [Real; 256] {
+    static VALUES: OnceLock<[Real; 256]> = OnceLock::new();
+    VALUES.get_or_init(|| std::array::from_fn(|byte| byte as Real / 255.0))
+}
+
 impl CubeMap {
-    /// Loads `dir/{left,right,up,down,front,back}.png`, decoding the six faces in parallel.
+    /// Reads and checks `dir/{left,right,up,down,front,back}.png`, in parallel.
     pub fn load(dir: &Path) -> Result<CubeMap, CubeMapError> {
         let faces: Vec<Face> = FACE_NAMES
             .par_iter()
-            .map(|name| load_face(&dir.join(format!("{name}.png"))))
+            .map(|name| Face::read(dir.join(format!("{name}.png"))))
             .collect::<Result<_, _>>()?;
         let faces: [Face; 6] = faces.try_into().expect("six names give six faces");
         Ok(CubeMap { faces })
@@ -61,10 +77,55 @@ impl CubeMap {
         }
         self.faces[face].bilinear(u, v)
     }
+
+    /// Decodes every face now instead of when first seen (for a scene rendered many times).
+    pub fn decode_all(&self) -> Result<(), CubeMapError> {
+        self.faces.par_iter().for_each(|face| {
+            face.texels();
+        });
+        self.failure().map_or(Ok(()), Err)
+    }
+
+    /// A face that a ray looked at but that could not be decoded (it showed black): the render
+    /// that saw it must be discarded. `None` when every face seen so far was decoded.
+    pub fn failure(&self) -> Option<CubeMapError> {
+        self.faces.iter().find_map(|face| match face.texels.get() {
+            Some(Err(reason)) => Some(CubeMapError { path: face.path.clone(), reason: reason.clone() }),
+            _ => None,
+        })
+    }
 }
 
 impl Face {
+    fn read(path: PathBuf) -> Result<Face, CubeMapError> {
+        let error = |reason: String| CubeMapError { path: path.clone(), reason };
+        let png = std::fs::read(&path).map_err(|e| error(e.to_string()))?;
+        check_chunks(&png).map_err(|reason| error(format!("not a valid PNG file: {reason}")))?;
+        let reader = image::ImageReader::with_format(std::io::Cursor::new(&png), ImageFormat::Png);
+        let (width, height) = reader.into_dimensions().map_err(|e| error(e.to_string()))?;
+        if width == 0 || height == 0 {
+            return Err(error("the image is empty".to_string()));
+        }
+        Ok(Face { path, png, width: width as usize, height: height as usize, texels: OnceLock::new() })
+    }
+
+    /// The decoded texels: decoded by the first ray to look, which any other waits for.
+    fn texels(&self) -> Option<&[[u8; 3]]> {
+        let texels = self.texels.get_or_init(|| {
+            let image = image::load_from_memory_with_format(&self.png, ImageFormat::Png)
+                .map_err(|e| e.to_string())?
+                .into_rgb8();
+            if (image.width() as usize, image.height() as usize) != (self.width, self.height) {
+                return Err("the image data does not match its header".to_string());
+            }
+            Ok(image.pixels().map(|p| p.0).collect())
+        });
+        texels.as_deref().ok()
+    }
+
     fn bilinear(&self, u: Real, v: Real) -> Color {
+        let Some(texels) = self.texels() else { return Color::ZERO };
+        let values = byte_values();
         let x = u * self.width as Real;
         let y = (1.0 - v) * self.height as Real;
         let (x0, y0) = (x.floor(), y.floor());
@@ -72,7 +133,8 @@ impl Face {
         let texel = |dx: Real, dy: Real| {
             let column = ((x0 + dx).max(0.0) as usize).min(self.width - 1);
             let row = ((y0 + dy).max(0.0) as usize).min(self.height - 1);
-            Color::from_array(self.texels[row * self.width + column])
+            let [r, g, b] = texels[row * self.width + column];
+            Color::new(values[r as usize], values[g as usize], values[b as usize])
         };
         texel(0.0, 0.0) * ((1.0 - alpha) * (1.0 - beta))
             + texel(1.0, 0.0) * (alpha * (1.0 - beta))
@@ -81,55 +143,87 @@ impl Face {
     }
 }
 
-fn load_face(path: &Path) -> Result<Face, CubeMapError> {
-    let error = |reason: String| CubeMapError { path: path.to_path_buf(), reason };
-    let image = image::open(path).map_err(|e| error(e.to_string()))?.into_rgb8();
-    let (width, height) = (image.width() as usize, image.height() as usize);
-    if width == 0 || height == 0 {
-        return Err(error("the image is empty".to_string()));
+/// Walks a PNG's chunks: the signature, each chunk's length within the file and its CRC, an
+/// `IHDR` first and an `IEND` last. What a decoder would reject about the file's structure,
+/// without inflating the image data.
+fn check_chunks(png: &[u8]) -> Result<(), String> {
+    const SIGNATURE: [u8; 8] = [0x89, b'P', b'N', b'G', b'\r', b'\n', 0x1a, b'\n'];
+    let mut rest = png.strip_prefix(&SIGNATURE[..]).ok_or("no PNG signature")?;
+    let mut first = true;
+    loop {
+        if rest.len() < 12 {
+            return Err("the file ends inside a chunk (no IEND)".to_string());
+        }
+        let length = u32::from_be_bytes(rest[..4].try_into().expect("four bytes")) as usize;
+        if length > rest.len() - 12 {
+            return Err("a chunk runs past the end of the file".to_string());
+        }
+        let (kind, data) = (&rest[4..8], &rest[8..8 + length]);
+        let crc = u32::from_be_bytes(rest[8 + length..12 + length].try_into().expect("four bytes"));
+        let mut hasher = crc32fast::Hasher::new();
+        hasher.update(kind);
+        hasher.update(data);
+        if hasher.finalize() != crc {
+            return Err(format!("the CRC of a {} chunk does not match", String::from_utf8_lossy(kind)));
+        }
+        if first && kind != b"IHDR" {
+            return Err("the first chunk is not IHDR".to_string());
+        }
+        first = false;
+        if kind == b"IEND" {
+            return Ok(());
+        }
+        rest = &rest[12 + length..];
     }
-    let texels = image.pixels().map(|p| p.0.map(|c| c as Real / 255.0)).collect();
-    Ok(Face { width, height, texels })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn uniform_face(value: Real) -> Face {
-        Face { width: 2, height: 2, texels: vec![[value; 3]; 4] }
+    fn face(width: usize, height: usize, texels: Vec<[u8; 3]>) -> Face {
+        let texels = OnceLock::from(Ok(texels));
+        Face { path: PathBuf::new(), png: Vec::new(), width, height, texels }
     }
 
-    fn cube(values: [Real; 6]) -> CubeMap {
-        CubeMap { faces: values.map(uniform_face) }
+    fn uniform_face(byte: u8) -> Face {
+        face(2, 2, vec![[byte; 3]; 4])
+    }
+
+    fn cube(bytes: [u8; 6]) -> CubeMap {
+        CubeMap { faces: bytes.map(uniform_face) }
+    }
+
+    fn value(byte: u8) -> Real {
+        byte as Real / 255.0
     }
 
     #[test]
     fn picks_the_face_of_the_largest_component_with_ties_to_x_then_y() {
-        let map = cube([0.1, 0.2, 0.3, 0.4, 0.5, 0.6]);
-        assert_eq!(map.radiance(Vec3::new(2.0, 1.0, 1.0)).x, 0.1);
-        assert_eq!(map.radiance(Vec3::new(-2.0, 1.0, 1.0)).x, 0.2);
-        assert_eq!(map.radiance(Vec3::new(0.0, 3.0, -1.0)).x, 0.3);
-        assert_eq!(map.radiance(Vec3::new(0.0, -3.0, 1.0)).x, 0.4);
-        assert_eq!(map.radiance(Vec3::new(0.5, 0.0, 1.0)).x, 0.5);
-        assert_eq!(map.radiance(Vec3::new(0.5, 0.0, -1.0)).x, 0.6);
-        assert_eq!(map.radiance(Vec3::new(1.0, 1.0, 1.0)).x, 0.1, "a three-way tie goes to x");
-        assert_eq!(map.radiance(Vec3::new(0.0, -1.0, 1.0)).x, 0.4, "a y–z tie goes to y");
+        let map = cube([10, 20, 30, 40, 50, 60]);
+        assert_eq!(map.radiance(Vec3::new(2.0, 1.0, 1.0)).x, value(10));
+        assert_eq!(map.radiance(Vec3::new(-2.0, 1.0, 1.0)).x, value(20));
+        assert_eq!(map.radiance(Vec3::new(0.0, 3.0, -1.0)).x, value(30));
+        assert_eq!(map.radiance(Vec3::new(0.0, -3.0, 1.0)).x, value(40));
+        assert_eq!(map.radiance(Vec3::new(0.5, 0.0, 1.0)).x, value(50));
+        assert_eq!(map.radiance(Vec3::new(0.5, 0.0, -1.0)).x, value(60));
+        assert_eq!(map.radiance(Vec3::new(1.0, 1.0, 1.0)).x, value(10), "a three-way tie goes to x");
+        assert_eq!(map.radiance(Vec3::new(0.0, -1.0, 1.0)).x, value(40), "a y–z tie goes to y");
     }
 
     #[test]
     fn bilinear_weights_follow_the_reference_indexing() {
-        // Columns 0..3 hold 0, 0.25, 0.5, 0.75 on every row.
-        let face = Face { width: 4, height: 1, texels: (0..4).map(|i| [i as Real * 0.25; 3]).collect() };
+        // Columns 0..3 hold 0, 0.2, 0.4, 0.6 on every row.
+        let face = face(4, 1, (0..4).map(|i| [i * 51; 3]).collect());
         // u = 0.3 → X = 1.2 → 0.8·texel(1) + 0.2·texel(2).
-        assert!((face.bilinear(0.3, 0.5).x - (0.8 * 0.25 + 0.2 * 0.5)).abs() < 1e-6);
+        assert!((face.bilinear(0.3, 0.5).x - (0.8 * 0.2 + 0.2 * 0.4)).abs() < 1e-6);
         // Past the last column the index clamps to the edge.
-        assert!((face.bilinear(0.99, 0.5).x - 0.75).abs() < 1e-6);
+        assert!((face.bilinear(0.99, 0.5).x - 0.6).abs() < 1e-6);
     }
 
     #[test]
     fn v_counts_up_from_the_bottom_row() {
-        let face = Face { width: 1, height: 2, texels: vec![[1.0; 3], [0.0; 3]] };
+        let face = face(1, 2, vec![[255; 3], [0; 3]]);
         assert!(face.bilinear(0.5, 0.99).x > 0.9, "v near 1 is the top row");
         assert!(face.bilinear(0.5, 0.01).x < 0.1, "v near 0 is the bottom row");
     }
@@ -139,5 +233,48 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let error = CubeMap::load(dir.path()).unwrap_err();
         assert!(error.path.starts_with(dir.path()), "{error}");
+    }
+
+    /// Six 2×2 faces, `right` with its image data cut to the zlib header (`fix_crc`: and its
+    /// chunk's length and CRC made to match, so that only decoding can tell).
+    fn faces_with_a_damaged_right_face(fix_crc: bool) -> tempfile::TempDir {
+        let dir = tempfile::tempdir().unwrap();
+        for name in FACE_NAMES {
+            let image = image::RgbImage::from_pixel(2, 2, image::Rgb([200, 100, 50]));
+            image.save(dir.path().join(format!("{name}.png"))).unwrap();
+        }
+        let path = dir.path().join("right.png");
+        let png = std::fs::read(&path).unwrap();
+        let idat = png.windows(4).position(|w| w == b"IDAT").unwrap();
+        let length = u32::from_be_bytes(png[idat - 4..idat].try_into().unwrap()) as usize;
+        let mut damaged = png[..idat - 4].to_vec();
+        damaged.extend(2u32.to_be_bytes());
+        damaged.extend(&png[idat..idat + 6]);
+        let crc = if fix_crc { crc32fast::hash(&png[idat..idat + 6]) } else { 0 };
+        damaged.extend(crc.to_be_bytes());
+        damaged.extend(&png[idat + 8 + length..]);
+        std::fs::write(&path, damaged).unwrap();
+        dir
+    }
+
+    #[test]
+    fn a_damaged_face_is_an_error_at_load() {
+        let dir = faces_with_a_damaged_right_face(false);
+        let error = CubeMap::load(dir.path()).unwrap_err();
+        assert!(error.path.ends_with("right.png") && error.reason.contains("CRC"), "{error}");
+    }
+
+    #[test]
+    fn faces_are_decoded_when_first_seen_and_an_undecodable_one_is_reported() {
+        let dir = faces_with_a_damaged_right_face(true);
+        let map = CubeMap::load(dir.path()).expect("the damage only shows when decoding");
+        assert!(map.faces.iter().all(|face| face.texels.get().is_none()), "nothing decoded yet");
+        assert_eq!(map.radiance(-Vec3::X), Color::new(value(200), value(100), value(50)));
+        assert!(map.failure().is_none(), "the left face decodes");
+        assert!(map.faces[RIGHT].texels.get().is_none(), "the right face was not needed");
+        assert_eq!(map.radiance(Vec3::X), Color::ZERO, "an undecodable face shows black");
+        let error = map.failure().expect("the right face could not be decoded");
+        assert!(error.path.ends_with("right.png"), "{error}");
+        assert!(map.decode_all().is_err());
     }
 }

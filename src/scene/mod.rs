@@ -11,7 +11,7 @@ mod object;
 
 pub use aggregate::{Aggregate, Intersection};
 pub use build::{build_scene, build_scene_measured};
-pub use cube_map::CubeMap;
+pub use cube_map::{CubeMap, CubeMapError};
 pub use object::{Object, Shape, ShapeHit, Triangle};
 
 use super::{geometry, real};
@@ -33,6 +33,28 @@ impl Background {
         match self {
             Background::Color(color) => *color,
             Background::CubeMap(map) => map.radiance(direction),
+        }
+    }
+}
+
+impl Scene {
+    /// A cube map face that could not be decoded when a ray first looked at it (the ray saw
+    /// black instead): a render for which this is `Some` must be discarded. Cube map faces are
+    /// checked at load, so this takes a PNG whose structure and checksums are sound but whose
+    /// image data is not.
+    pub fn render_failure(&self) -> Option<CubeMapError> {
+        match &self.background {
+            Background::CubeMap(map) => map.failure(),
+            Background::Color(_) => None,
+        }
+    }
+
+    /// Decodes every cube map face now, so that no render of the scene can fail: for callers that
+    /// render one scene many times.
+    pub fn decode_everything(&self) -> Result<(), CubeMapError> {
+        match &self.background {
+            Background::CubeMap(map) => map.decode_all(),
+            Background::Color(_) => Ok(()),
         }
     }
 }

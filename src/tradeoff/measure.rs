@@ -7,6 +7,7 @@ use std::time::{Duration, Instant};
 
 use super::error::TradeoffError;
 use super::setting::Setting;
+use crate::build_error::BuildError;
 use crate::case::Case;
 use crate::compare::{Image, Tolerance, compare};
 use crate::film::Film;
@@ -59,11 +60,14 @@ pub struct Reference {
 
 impl<'a> Renderer<'a> {
     pub fn new(case: &'a Case) -> Result<Renderer<'a>, TradeoffError> {
-        Ok(Renderer {
-            case,
-            single: single::scene::build_scene(case)?,
-            double: double::scene::build_scene(case)?,
-        })
+        let (single, double) = (single::scene::build_scene(case)?, double::scene::build_scene(case)?);
+        // Cube map faces are otherwise decoded when a render first sees them.
+        let decoded = single.decode_everything().and_then(|()| double.decode_everything());
+        decoded.map_err(|source| BuildError::CubeMap {
+            file: case.path.clone(),
+            source,
+        })?;
+        Ok(Renderer { case, single, double })
     }
 
     /// One render of the film `options` describe, in `precision`, with its rays.

@@ -67,8 +67,8 @@ fn no_aov_rays_when_no_aov_is_written() {
     }
 }
 
-/// Infinite planes are tested beside the tree, and a handful of objects are scanned in a loop:
-/// neither a scene of planes nor one of a single sphere builds (or traverses) a scene BVH.
+/// Infinite planes are tested beside the tree, and a handful of plain spheres side by side:
+/// neither a scene of planes nor one of a few spheres builds (or traverses) a scene BVH.
 #[test]
 fn no_scene_bvh_for_planes_or_a_single_object() {
     let plane = |offset: i32| format!("[[object]]\nkind = \"plane\"\nnormal = [0, 1, 0]\noffset = {offset}\n");
@@ -87,7 +87,11 @@ fn no_scene_bvh_for_planes_or_a_single_object() {
         "one sphere over a plane"
     );
     assert!(
-        scene_bvh(&(-3..3).map(sphere).collect::<String>()),
-        "six spheres do get a tree"
+        !scene_bvh(&(-3..3).map(sphere).collect::<String>()),
+        "six spheres are tested side by side"
+    );
+    assert!(
+        scene_bvh(&(-6..6).map(sphere).collect::<String>()),
+        "twelve spheres do get a tree"
     );
 }

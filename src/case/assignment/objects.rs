@@ -8,32 +8,39 @@ use super::{Parser, usable_in_single_precision};
 use crate::case::objects::{file_problem, singularity};
 use crate::case::spec::{ObjectSpec, ShapeSpec, TransformOp};
 
-const GROUP_WORDS: &[&str] = &[
-    "Group",
-    "Sphere",
-    "Plane",
-    "Triangle",
-    "TriangleMesh",
-    "Transform",
-    "MaterialIndex",
-];
+/// What a group or a transform may hold.
+const OBJECT_WORDS: [&str; 6] = ["Group", "Sphere", "Plane", "Triangle", "TriangleMesh", "Transform"];
+/// What may come in a group: an object, or the material of what follows.
+const GROUP_WORDS: [&str; 7] = concat(OBJECT_WORDS, ["MaterialIndex"]);
+/// What may come in a transform: its ops, then its object.
+const TRANSFORM_WORDS: [&str; 14] = concat(
+    [
+        "Scale",
+        "UniformScale",
+        "Translate",
+        "XRotate",
+        "YRotate",
+        "ZRotate",
+        "Rotate",
+        "Matrix4f",
+    ],
+    OBJECT_WORDS,
+);
 
-const TRANSFORM_WORDS: &[&str] = &[
-    "Scale",
-    "UniformScale",
-    "Translate",
-    "XRotate",
-    "YRotate",
-    "ZRotate",
-    "Rotate",
-    "Matrix4f",
-    "Group",
-    "Sphere",
-    "Plane",
-    "Triangle",
-    "TriangleMesh",
-    "Transform",
-];
+/// `first` then `second`, for keyword lists that share a part (`N` must be `A + B`).
+const fn concat<const A: usize, const B: usize, const N: usize>(
+    first: [&'static str; A],
+    second: [&'static str; B],
+) -> [&'static str; N] {
+    assert!(A + B == N, "the lengths must add up");
+    let mut all = [""; N];
+    let mut i = 0;
+    while i < N {
+        all[i] = if i < A { first[i] } else { second[i - A] };
+        i += 1;
+    }
+    all
+}
 
 /// Far deeper than any real scene, and shallow enough that neither this recursive parser nor
 /// the TOML written by `case_to_toml` (toml's own limit is 80 levels) can run out of depth.
@@ -54,7 +61,7 @@ impl<'a> Parser<'a> {
                     let given = objects.len();
                     return Err(self.too_few(token, "numObjects", count, given, "object"));
                 }
-                _ => objects.push(self.object(token, "object", GROUP_WORDS, "objects")?),
+                _ => objects.push(self.object(token, "object", &GROUP_WORDS, "objects")?),
             }
         }
         self.lex
@@ -223,7 +230,7 @@ impl<'a> Parser<'a> {
                     return Err(self.lex.error_at(token.start, message));
                 }
                 _ => {
-                    break self.object(token, "transform op or object", TRANSFORM_WORDS, "ops and objects")?;
+                    break self.object(token, "transform op or object", &TRANSFORM_WORDS, "ops and objects")?;
                 }
             };
             ops.push(op);

@@ -1,9 +1,15 @@
-//! Binned-SAH construction of a flattened binary BVH, which `collapse` then turns into the 4-wide
+//! Binned-SAH construction of a flattened binary BVH, which `collapse` then turns into the 8-wide
 //! tree that is traversed.
 //!
 //! Every split decision is a pure function of the primitives in the node, and subtrees built in
 //! parallel are stitched together in a fixed order, so the result does not depend on how rayon
 //! schedules the work.
+//!
+//! Each node costs two passes over its primitives: binning (which also gives both children's
+//! boxes, as unions of bins) and partitioning (which also gives both children's centroid
+//! bounds). The largest nodes are binned in parallel.
+
+use rayon::prelude::*;
 
 use super::super::aabb::Aabb;
 use super::super::real::{Real, Vec3};
@@ -19,15 +25,50 @@ const TRAVERSAL_COST: Real = 1.0;
 /// Below this many primitives a subtree is cheaper to build on the current thread than to
 /// hand to rayon and stitch back.
 const PARALLEL_THRESHOLD: usize = 4096;
+/// From this many primitives a node's binning pass is itself split among threads (the first
+/// levels of the tree, before there are subtrees enough to keep every thread busy).
+const PARALLEL_BINNING: usize = 1 << 17;
 /// Depth after which only median splits are made. SAH splits may peel off one primitive at a
 /// time on adversarial input; median splits guarantee the remaining depth is logarithmic.
 pub(super) const SAH_DEPTH_LIMIT: usize = 32;
+
+/// How the SAH prices a leaf.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LeafCost {
+    /// Each primitive is tested on its own: a leaf of `n` costs `n` tests.
+    PerPrimitive,
+    /// Primitives are tested four at a time (a mesh's triangle packs): a leaf of `n` costs
+    /// `⌈n/4⌉` tests, so leaves fill up to four.
+    PerPackOfFour,
+    /// Every primitive is a leaf of its own, behind its own box: for primitives whose test costs
+    /// far more than a box (a scene's objects: instances move the ray into their space first).
+    Single,
+}
+
+impl LeafCost {
+    fn tests(self, count: usize) -> Real {
+        match self {
+            LeafCost::PerPrimitive | LeafCost::Single => count as Real,
+            LeafCost::PerPackOfFour => count.div_ceil(4) as Real,
+        }
+    }
+
+    /// The most primitives a leaf may hold.
+    fn max_leaf(self) -> usize {
+        match self {
+            LeafCost::Single => 1,
+            _ => MAX_LEAF_PRIMS,
+        }
+    }
+}
 
 /// One node of the binary tree. Nodes are stored depth first: an interior node's first child
 /// immediately follows it, so only the second child's index needs storing.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct BinaryNode {
     pub bounds: Aabb,
+    /// `bounds.surface_area()`, which the collapse compares many times.
+    pub area: Real,
     /// Leaf: index of its first entry in the primitive order. Interior: the second child.
     pub offset: u32,
     /// Zero for an interior node.
@@ -36,11 +77,11 @@ pub(super) struct BinaryNode {
 
 impl BinaryNode {
     fn leaf(bounds: Aabb, first: usize, count: usize) -> Self {
-        BinaryNode { bounds, offset: first as u32, prim_count: count as u32 }
+        BinaryNode { bounds, area: bounds.surface_area(), offset: first as u32, prim_count: count as u32 }
     }
 
     fn interior(bounds: Aabb) -> Self {
-        BinaryNode { bounds, offset: 0, prim_count: 0 }
+        BinaryNode { bounds, area: bounds.surface_area(), offset: 0, prim_count: 0 }
     }
 
     pub fn is_leaf(&self) -> bool {
@@ -49,7 +90,7 @@ impl BinaryNode {
 }
 
 /// Returns the nodes in depth-first order and the primitive indices in leaf order.
-pub(super) fn build(bounds: &[Aabb]) -> (Vec<BinaryNode>, Vec<u32>) {
+pub(super) fn build(bounds: &[Aabb], cost: LeafCost) -> (Vec<BinaryNode>, Vec<u32>) {
     assert!(
         u32::try_from(bounds.len()).is_ok(),
         "a BVH holds at most u32::MAX primitives"
@@ -58,15 +99,12 @@ pub(super) fn build(bounds: &[Aabb]) -> (Vec<BinaryNode>, Vec<u32>) {
         return (Vec::new(), Vec::new());
     }
     let mut prims: Vec<Prim> = bounds
-        .iter()
+        .par_iter()
         .enumerate()
-        .map(|(index, &bounds)| Prim {
-            bounds,
-            centroid: bounds.centroid(),
-            index: index as u32,
-        })
+        .map(|(index, bounds)| Prim::new(bounds, index))
         .collect();
-    let subtree = build_parallel(&mut prims, 0, 0);
+    let root = Extent::of_parallel(&prims);
+    let subtree = build_parallel(Node { prims: &mut prims, extent: root, first: 0, depth: 0 }, cost);
     let mut nodes = Vec::new();
     flatten(subtree, &mut nodes);
     (nodes, prims.iter().map(|prim| prim.index).collect())
@@ -74,22 +112,129 @@ pub(super) fn build(bounds: &[Aabb]) -> (Vec<BinaryNode>, Vec<u32>) {
 
 /// A primitive as the build moves it around. Partitioning these records in place, rather than
 /// an index list into the caller's boxes, keeps every pass over a node sequential in memory.
+/// Plain arrays of four (the fourth is zero), so that the split axis indexes them without a
+/// branch and a box grows by one vector minimum and maximum.
 #[derive(Clone, Copy)]
+#[repr(C)]
 struct Prim {
-    bounds: Aabb,
-    centroid: Vec3,
+    min: [Real; 4],
+    max: [Real; 4],
     index: u32,
 }
 
-/// How a node was decided; for a split, its primitives have already been partitioned at `mid`.
+impl Prim {
+    fn new(bounds: &Aabb, index: usize) -> Prim {
+        let (min, max) = (bounds.min, bounds.max);
+        Prim { min: [min.x, min.y, min.z, 0.0], max: [max.x, max.y, max.z, 0.0], index: index as u32 }
+    }
+
+    /// The centre of the box on one axis, halved before adding (as `Aabb::centroid`).
+    #[inline(always)]
+    fn centroid(&self, axis: usize) -> Real {
+        self.min[axis] * 0.5 + self.max[axis] * 0.5
+    }
+
+    #[inline(always)]
+    fn centroid4(&self) -> [Real; 4] {
+        std::array::from_fn(|axis| self.min[axis] * 0.5 + self.max[axis] * 0.5)
+    }
+}
+
+/// A box as two arrays of four: the union of primitives' boxes in the build's inner loops.
+#[derive(Clone, Copy)]
+struct Bounds {
+    min: [Real; 4],
+    max: [Real; 4],
+}
+
+impl Bounds {
+    const EMPTY: Bounds = Bounds { min: [Real::INFINITY; 4], max: [Real::NEG_INFINITY; 4] };
+
+    /// Grows the box by `[min, max]`. Written `new < old ? new : old`, which a NaN bound leaves as
+    /// it is (as `f32::min` and `f32::max` do, the accumulated bounds never being NaN), one
+    /// vector instruction each.
+    #[inline(always)]
+    fn grow(&mut self, min: &[Real; 4], max: &[Real; 4]) {
+        let (mut low, mut high) = (self.min, self.max);
+        for axis in 0..4 {
+            low[axis] = if min[axis] < low[axis] { min[axis] } else { low[axis] };
+            high[axis] = if max[axis] > high[axis] { max[axis] } else { high[axis] };
+        }
+        (self.min, self.max) = (low, high);
+    }
+
+    #[inline(always)]
+    fn union(mut self, other: &Bounds) -> Bounds {
+        self.grow(&other.min, &other.max);
+        self
+    }
+
+    /// `Aabb::surface_area`: zero for an empty box.
+    #[inline(always)]
+    fn area(&self) -> Real {
+        if !(self.min[0] <= self.max[0] && self.min[1] <= self.max[1] && self.min[2] <= self.max[2]) {
+            return 0.0;
+        }
+        let d = [self.max[0] - self.min[0], self.max[1] - self.min[1], self.max[2] - self.min[2]];
+        2.0 * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0])
+    }
+
+    fn aabb(&self) -> Aabb {
+        Aabb::new(
+            Vec3::new(self.min[0], self.min[1], self.min[2]),
+            Vec3::new(self.max[0], self.max[1], self.max[2]),
+        )
+    }
+}
+
+/// A node's box and the box of its primitives' centroids.
+#[derive(Clone, Copy)]
+struct Extent {
+    bounds: Bounds,
+    centroids: Bounds,
+}
+
+impl Extent {
+    const EMPTY: Extent = Extent { bounds: Bounds::EMPTY, centroids: Bounds::EMPTY };
+
+    fn add(mut self, prim: &Prim) -> Extent {
+        self.bounds.grow(&prim.min, &prim.max);
+        let centroid = prim.centroid4();
+        self.centroids.grow(&centroid, &centroid);
+        self
+    }
+
+    fn union(self, other: Extent) -> Extent {
+        Extent { bounds: self.bounds.union(&other.bounds), centroids: self.centroids.union(&other.centroids) }
+    }
+
+    fn of(prims: &[Prim]) -> Extent {
+        prims.iter().fold(Extent::EMPTY, Extent::add)
+    }
+
+    /// [`Extent::of`] in parallel: unions are exact, so the order of the reduction is irrelevant.
+    fn of_parallel(prims: &[Prim]) -> Extent {
+        prims.par_chunks(PARALLEL_THRESHOLD).map(Extent::of).reduce(|| Extent::EMPTY, Extent::union)
+    }
+}
+
+/// A node to build: its primitives (in place), their extent, where they start in the primitive
+/// order, and the node's depth.
+struct Node<'a> {
+    prims: &'a mut [Prim],
+    extent: Extent,
+    first: usize,
+    depth: usize,
+}
+
+/// How a node was decided; for a split, its primitives have already been partitioned at `mid`
+/// and the children's extents are known.
+// A plan lives for one node on the stack, never in a collection: boxing the split would cost an
+// allocation per node for nothing.
+#[allow(clippy::large_enum_variant)]
 enum Plan {
-    Leaf {
-        bounds: Aabb,
-    },
-    Split {
-        bounds: Aabb,
-        mid: usize,
-    },
+    Leaf,
+    Split { mid: usize, below: Extent, above: Extent },
 }
 
 /// A subtree as returned by a parallel task: either a finished run of nodes (child indices
@@ -102,38 +247,39 @@ enum Subtree {
     },
 }
 
-fn build_parallel(prims: &mut [Prim], first: usize, depth: usize) -> Subtree {
-    if prims.len() < PARALLEL_THRESHOLD {
-        let mut nodes = Vec::with_capacity(prims.len());
-        build_serial(prims, first, depth, &mut nodes);
+fn build_parallel(node: Node, cost: LeafCost) -> Subtree {
+    if node.prims.len() < PARALLEL_THRESHOLD {
+        let mut nodes = Vec::with_capacity(node.prims.len());
+        build_serial(node, cost, &mut nodes);
         return Subtree::Nodes(nodes);
     }
-    match plan(prims, depth) {
-        Plan::Leaf { bounds } => Subtree::Nodes(vec![BinaryNode::leaf(bounds, first, prims.len())]),
-        Plan::Split { bounds, mid } => {
-            let (below, above) = prims.split_at_mut(mid);
+    let bounds = node.extent.bounds.aabb();
+    match plan(node.prims, node.extent, node.depth, cost) {
+        Plan::Leaf => Subtree::Nodes(vec![BinaryNode::leaf(bounds, node.first, node.prims.len())]),
+        Plan::Split { mid, below, above } => {
+            let (below_prims, above_prims) = node.prims.split_at_mut(mid);
+            let depth = node.depth + 1;
             let children = rayon::join(
-                || build_parallel(below, first, depth + 1),
-                || build_parallel(above, first + mid, depth + 1),
+                || build_parallel(Node { prims: below_prims, extent: below, first: node.first, depth }, cost),
+                || build_parallel(Node { prims: above_prims, extent: above, first: node.first + mid, depth }, cost),
             );
-            Subtree::Split {
-                bounds,
-                children: Box::new(children),
-            }
+            Subtree::Split { bounds, children: Box::new(children) }
         }
     }
 }
 
-fn build_serial(prims: &mut [Prim], first: usize, depth: usize, nodes: &mut Vec<BinaryNode>) {
-    match plan(prims, depth) {
-        Plan::Leaf { bounds } => nodes.push(BinaryNode::leaf(bounds, first, prims.len())),
-        Plan::Split { bounds, mid } => {
+fn build_serial(node: Node, cost: LeafCost, nodes: &mut Vec<BinaryNode>) {
+    let bounds = node.extent.bounds.aabb();
+    match plan(node.prims, node.extent, node.depth, cost) {
+        Plan::Leaf => nodes.push(BinaryNode::leaf(bounds, node.first, node.prims.len())),
+        Plan::Split { mid, below, above } => {
             let index = nodes.len();
             nodes.push(BinaryNode::interior(bounds));
-            let (below, above) = prims.split_at_mut(mid);
-            build_serial(below, first, depth + 1, nodes);
+            let (below_prims, above_prims) = node.prims.split_at_mut(mid);
+            let depth = node.depth + 1;
+            build_serial(Node { prims: below_prims, extent: below, first: node.first, depth }, cost, nodes);
             nodes[index].offset = nodes.len() as u32;
-            build_serial(above, first + mid, depth + 1, nodes);
+            build_serial(Node { prims: above_prims, extent: above, first: node.first + mid, depth }, cost, nodes);
         }
     }
 }
@@ -162,114 +308,167 @@ fn flatten(subtree: Subtree, nodes: &mut Vec<BinaryNode>) {
     }
 }
 
-fn plan(prims: &mut [Prim], depth: usize) -> Plan {
-    let (bounds, centroid_bounds) = prims
-        .iter()
-        .fold((Aabb::EMPTY, Aabb::EMPTY), |(b, c), prim| {
-            (b.union(prim.bounds), c.grow(prim.centroid))
-        });
+/// Splits the list as it is at `mid`; the children's extents come from one pass over each half.
+fn split_in_order(prims: &[Prim], mid: usize) -> Plan {
+    let (below, above) = prims.split_at(mid);
+    Plan::Split { mid, below: Extent::of(below), above: Extent::of(above) }
+}
+
+fn plan(prims: &mut [Prim], extent: Extent, depth: usize, cost: LeafCost) -> Plan {
     let count = prims.len();
-    if count == 1 {
-        return Plan::Leaf { bounds };
+    // One test for the whole leaf costs no more than visiting a node would, so no split can win:
+    // the SAH below would choose the leaf too, at the cost of binning.
+    if count == 1 || (count <= cost.max_leaf() && cost.tests(count) <= TRAVERSAL_COST) {
+        return Plan::Leaf;
     }
+    let (bounds, centroid_bounds) = (extent.bounds.aabb(), extent.centroids.aabb());
     let axis = centroid_bounds.longest_axis();
     let spread = centroid_bounds.extent()[axis];
     if spread.is_nan() || spread <= 0.0 {
         // All centroids coincide (or are not finite): no position separates them, so halve
         // the list as it is.
-        return if count <= MAX_LEAF_PRIMS {
-            Plan::Leaf { bounds }
-        } else {
-            Plan::Split {
-                bounds,
-                mid: count / 2,
-            }
-        };
+        return if count <= cost.max_leaf() { Plan::Leaf } else { split_in_order(prims, count / 2) };
     }
     if depth >= SAH_DEPTH_LIMIT {
-        return if count <= MAX_LEAF_PRIMS {
-            Plan::Leaf { bounds }
-        } else {
-            median_split(prims, bounds, axis)
-        };
+        return if count <= cost.max_leaf() { Plan::Leaf } else { median_split(prims, axis) };
     }
-    let (low, bins_per_unit) = (centroid_bounds.min[axis], BIN_COUNT as Real / spread);
-    let bin_of = |prim: &Prim| {
-        // The float-to-int cast saturates (NaN and −∞ become 0), so every value lands in a bin,
-        // even when a tiny spread makes `bins_per_unit` infinite.
-        (((prim.centroid[axis] - low) * bins_per_unit) as usize).min(BIN_COUNT - 1)
+    let bins = Bins { axis, low: centroid_bounds.min[axis], per_unit: BIN_COUNT as Real / spread };
+    let binned = if count >= PARALLEL_BINNING {
+        prims.par_chunks(PARALLEL_THRESHOLD).map(|chunk| bins.fill(chunk)).reduce(Binned::empty, Binned::merge)
+    } else {
+        bins.fill(prims)
     };
-    let Some((split_bin, split_cost)) = best_bin_split(prims, &bin_of) else {
-        return if count <= MAX_LEAF_PRIMS {
-            Plan::Leaf { bounds }
-        } else {
-            median_split(prims, bounds, axis)
-        };
+    let Some((split_bin, split_cost)) = binned.best_split(count, cost) else {
+        return if count <= cost.max_leaf() { Plan::Leaf } else { median_split(prims, axis) };
     };
     // Costs are kept multiplied by the node's area, so a degenerate (zero-area) node needs no
     // division and simply compares 0 with 0, which chooses a leaf.
     let area = bounds.surface_area();
-    let leaf_cost = count as Real * area;
-    if count <= MAX_LEAF_PRIMS && TRAVERSAL_COST * area + split_cost >= leaf_cost {
-        return Plan::Leaf { bounds };
+    let leaf_cost = cost.tests(count) * area;
+    if count <= cost.max_leaf() && TRAVERSAL_COST * area + split_cost >= leaf_cost {
+        return Plan::Leaf;
     }
-    let mid = partition(prims, |prim| bin_of(prim) <= split_bin);
-    Plan::Split { bounds, mid }
+    let (mid, below_centroids, above_centroids) = partition(prims, |prim| bins.bin(prim) <= split_bin);
+    let side = |range: std::ops::Range<usize>| binned.boxes[range].iter().fold(Bounds::EMPTY, |b, bin| b.union(bin));
+    Plan::Split {
+        mid,
+        below: Extent { bounds: side(0..split_bin + 1), centroids: below_centroids },
+        above: Extent { bounds: side(split_bin + 1..BIN_COUNT), centroids: above_centroids },
+    }
 }
 
-/// The bin after which splitting is cheapest, with its cost `Σ count·area` over both sides.
-/// `None` when every primitive falls into a single bin.
-fn best_bin_split(prims: &[Prim], bin_of: &impl Fn(&Prim) -> usize) -> Option<(usize, Real)> {
-    let mut counts = [0usize; BIN_COUNT];
-    let mut boxes = [Aabb::EMPTY; BIN_COUNT];
-    for prim in prims {
-        let bin = bin_of(prim);
-        counts[bin] += 1;
-        boxes[bin] = boxes[bin].union(prim.bounds);
+/// Where centroids fall along the split axis.
+#[derive(Clone, Copy)]
+struct Bins {
+    axis: usize,
+    low: Real,
+    per_unit: Real,
+}
+
+impl Bins {
+    #[inline(always)]
+    fn bin(&self, prim: &Prim) -> usize {
+        // The float-to-int cast saturates (NaN becomes 0), so every value lands in a bin, even
+        // when a tiny spread makes `per_unit` infinite.
+        (((prim.centroid(self.axis) - self.low) * self.per_unit) as i32).clamp(0, BIN_COUNT as i32 - 1) as usize
     }
-    let mut above_cost = [0.0; BIN_COUNT];
-    let (mut above_count, mut above_box) = (0, Aabb::EMPTY);
-    for bin in (1..BIN_COUNT).rev() {
-        above_count += counts[bin];
-        above_box = above_box.union(boxes[bin]);
-        above_cost[bin - 1] = above_count as Real * above_box.surface_area();
-    }
-    let (mut below_count, mut below_box) = (0, Aabb::EMPTY);
-    let mut best: Option<(usize, Real)> = None;
-    for split in 0..BIN_COUNT - 1 {
-        below_count += counts[split];
-        below_box = below_box.union(boxes[split]);
-        if below_count == 0 || below_count == prims.len() {
-            continue;
+
+    fn fill(&self, prims: &[Prim]) -> Binned {
+        let mut binned = Binned::empty();
+        for prim in prims {
+            let bin = self.bin(prim);
+            binned.counts[bin] += 1;
+            binned.boxes[bin].grow(&prim.min, &prim.max);
         }
-        let cost = below_count as Real * below_box.surface_area() + above_cost[split];
-        if best.is_none_or(|(_, best_cost)| cost < best_cost) {
-            best = Some((split, cost));
-        }
+        binned
     }
-    best
+}
+
+/// Each bin's primitive count and box.
+struct Binned {
+    counts: [usize; BIN_COUNT],
+    boxes: [Bounds; BIN_COUNT],
+}
+
+impl Binned {
+    fn empty() -> Binned {
+        Binned { counts: [0; BIN_COUNT], boxes: [Bounds::EMPTY; BIN_COUNT] }
+    }
+
+    /// Counts add and boxes unite exactly, so merging partial binnings in any order gives the
+    /// binning of the whole.
+    fn merge(mut self, other: Binned) -> Binned {
+        for bin in 0..BIN_COUNT {
+            self.counts[bin] += other.counts[bin];
+            self.boxes[bin] = self.boxes[bin].union(&other.boxes[bin]);
+        }
+        self
+    }
+
+    /// The bin after which splitting is cheapest, with its cost `Σ tests·area` over both sides.
+    /// `None` when every primitive falls into a single bin.
+    fn best_split(&self, count: usize, cost: LeafCost) -> Option<(usize, Real)> {
+        let mut above_cost = [0.0; BIN_COUNT];
+        let (mut above_count, mut above_box) = (0, Bounds::EMPTY);
+        for bin in (1..BIN_COUNT).rev() {
+            above_count += self.counts[bin];
+            above_box = above_box.union(&self.boxes[bin]);
+            above_cost[bin - 1] = cost.tests(above_count) * above_box.area();
+        }
+        let (mut below_count, mut below_box) = (0, Bounds::EMPTY);
+        let mut best: Option<(usize, Real)> = None;
+        for (split, &above) in above_cost.iter().enumerate().take(BIN_COUNT - 1) {
+            below_count += self.counts[split];
+            below_box = below_box.union(&self.boxes[split]);
+            if below_count == 0 || below_count == count {
+                continue;
+            }
+            let split_cost = cost.tests(below_count) * below_box.area() + above;
+            if best.is_none_or(|(_, best_cost)| split_cost < best_cost) {
+                best = Some((split, split_cost));
+            }
+        }
+        best
+    }
 }
 
 /// Splits at the median centroid along `axis`; ties are broken by primitive index so the
 /// result does not depend on the incoming order.
-fn median_split(prims: &mut [Prim], bounds: Aabb, axis: usize) -> Plan {
+fn median_split(prims: &mut [Prim], axis: usize) -> Plan {
     let mid = prims.len() / 2;
     prims.select_nth_unstable_by(mid, |a, b| {
-        a.centroid[axis]
-            .total_cmp(&b.centroid[axis])
-            .then(a.index.cmp(&b.index))
+        a.centroid(axis).total_cmp(&b.centroid(axis)).then(a.index.cmp(&b.index))
     });
-    Plan::Split { bounds, mid }
+    split_in_order(prims, mid)
 }
 
-/// Moves the primitives satisfying `goes_below` to the front and returns how many there are.
-fn partition(prims: &mut [Prim], goes_below: impl Fn(&Prim) -> bool) -> usize {
-    let mut below = 0;
-    for i in 0..prims.len() {
-        if goes_below(&prims[i]) {
-            prims.swap(below, i);
-            below += 1;
+/// Moves the primitives satisfying `goes_below` to the front; returns how many there are and
+/// the centroid bounds of each side. Hoare's scheme: each primitive is tested once, and only
+/// pairs on the wrong sides are swapped.
+fn partition(prims: &mut [Prim], goes_below: impl Fn(&Prim) -> bool) -> (usize, Bounds, Bounds) {
+    let (mut below_centroids, mut above_centroids) = (Bounds::EMPTY, Bounds::EMPTY);
+    let grow = |bounds: &mut Bounds, prim: &Prim| {
+        let centroid = prim.centroid4();
+        bounds.grow(&centroid, &centroid);
+    };
+    let (mut low, mut high) = (0, prims.len());
+    loop {
+        while low < high && goes_below(&prims[low]) {
+            grow(&mut below_centroids, &prims[low]);
+            low += 1;
         }
+        while low < high && !goes_below(&prims[high - 1]) {
+            grow(&mut above_centroids, &prims[high - 1]);
+            high -= 1;
+        }
+        if low >= high {
+            return (low, below_centroids, above_centroids);
+        }
+        // `prims[low]` belongs above and `prims[high − 1]` below.
+        prims.swap(low, high - 1);
+        grow(&mut below_centroids, &prims[low]);
+        grow(&mut above_centroids, &prims[high - 1]);
+        low += 1;
+        high -= 1;
     }
-    below
 }

@@ -1,8 +1,8 @@
-//! Collapsing the binary SAH tree into the 4-wide tree that is traversed.
+//! Collapsing the binary SAH tree into the 8-wide tree that is traversed.
 //!
 //! A wide node takes the two children of a binary node and keeps replacing its interior child
 //! with the largest surface area (the one a ray is likeliest to enter) by that child's own two
-//! children, until it has four children or only leaves are left (the usual BVH2 → BVH4
+//! children, until it has eight children or only leaves are left (the usual BVH2 → BVH8
 //! collapse, as in Embree). Every binary leaf becomes one leaf slot of a wide node, with the
 //! same primitives; children keep their left-to-right order. A pure function of the binary
 //! tree, so the wide tree is as deterministic as the binary one.
@@ -59,5 +59,5 @@ fn children(binary: &[BinaryNode], index: usize) -> ([usize; WIDTH], usize) {
 }
 
 fn area(binary: &[BinaryNode], index: usize) -> Real {
-    binary[index].bounds.surface_area()
+    binary[index].area
 }

@@ -1,0 +1,263 @@
+//! Which SIMD instruction set the ray kernels run on, and the lane types they are written with.
+//!
+//! The kernels (BVH traversal, the triangle and sphere tests) are written once, generic over an
+//! instruction set [`Isa`], against the lane types it provides ([`Lanes`]: 4 or 8 `f32` or `f64`
+//! side by side). Each kernel is compiled once per path: [`SimdPath::Portable`] (plain arrays,
+//! any processor), [`SimdPath::Avx2`] and [`SimdPath::Avx512`] (x86-64 intrinsics, each kernel
+//! compiled with those instructions enabled). [`dispatch`] runs a kernel on the path chosen at
+//! run time: the widest the processor supports, unless the environment variable `GOLDRAY_SIMD`
+//! (`portable`, `avx2`, `avx512`) or [`set_path`] chooses another.
+//!
+//! **Every path computes the same numbers.** Each lane operation is one IEEE operation with one
+//! defined result (Rust never fuses a multiply and an add), `max`/`min` follow x86's rule on
+//! every path (`a > b ? a : b`, so a NaN yields the second operand), and the kernels do the same
+//! operations in the same order whatever the lane type. So a picture is bit-identical whichever
+//! path renders it; `tests/simd_paths.rs` forces each available path and compares the EXR bytes.
+
+use std::ops::{Add, Div, Mul, Neg, Sub};
+use std::sync::atomic::{AtomicU8, Ordering};
+
+mod portable;
+#[cfg(target_arch = "x86_64")]
+mod x86;
+
+pub use portable::Portable;
+#[cfg(target_arch = "x86_64")]
+pub use x86::{Avx2, Avx512};
+
+/// An instruction set the kernels can be compiled for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum SimdPath {
+    /// Plain arrays of lanes, left to the compiler: any processor.
+    Portable,
+    /// x86-64 with AVX2 and FMA (Haswell, 2013, and later).
+    Avx2,
+    /// x86-64 with AVX-512 F, VL, BW and DQ (Skylake-SP, Ice Lake, Zen 4 and later).
+    Avx512,
+}
+
+impl SimdPath {
+    pub const ALL: [SimdPath; 3] = [SimdPath::Portable, SimdPath::Avx2, SimdPath::Avx512];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            SimdPath::Portable => "portable",
+            SimdPath::Avx2 => "avx2",
+            SimdPath::Avx512 => "avx512",
+        }
+    }
+
+    /// Whether this processor can run the path.
+    pub fn is_supported(self) -> bool {
+        match self {
+            SimdPath::Portable => true,
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Avx2 => x86::has_avx2(),
+            #[cfg(target_arch = "x86_64")]
+            SimdPath::Avx512 => x86::has_avx512(),
+            #[cfg(not(target_arch = "x86_64"))]
+            _ => false,
+        }
+    }
+
+    fn from_name(name: &str) -> Option<SimdPath> {
+        SimdPath::ALL
+            .into_iter()
+            .find(|path| path.name().eq_ignore_ascii_case(name.trim()))
+    }
+
+    /// How `PATH` stores it (zero: not chosen yet); `path` decodes it.
+    fn code(self) -> u8 {
+        match self {
+            SimdPath::Portable => 1,
+            SimdPath::Avx2 => 2,
+            SimdPath::Avx512 => 3,
+        }
+    }
+
+    fn from_code(code: u8) -> SimdPath {
+        SimdPath::ALL[code as usize - 1]
+    }
+}
+
+/// The paths this processor can run, narrowest first.
+pub fn available() -> Vec<SimdPath> {
+    SimdPath::ALL.into_iter().filter(|path| path.is_supported()).collect()
+}
+
+/// The widest path this processor supports.
+pub fn detected() -> SimdPath {
+    *available().last().expect("the portable path is always available")
+}
+
+/// Zero until the path is first asked for.
+static PATH: AtomicU8 = AtomicU8::new(0);
+
+/// The path kernels run on: [`set_path`]'s choice, else `GOLDRAY_SIMD`'s when this processor
+/// supports it, else [`detected`].
+#[inline]
+pub fn path() -> SimdPath {
+    match PATH.load(Ordering::Relaxed) {
+        1 => SimdPath::Portable,
+        2 => SimdPath::Avx2,
+        3 => SimdPath::Avx512,
+        _ => initial_path(),
+    }
+}
+
+#[cold]
+fn initial_path() -> SimdPath {
+    let requested = std::env::var("GOLDRAY_SIMD")
+        .ok()
+        .and_then(|name| SimdPath::from_name(&name));
+    let path = requested.filter(|path| path.is_supported()).unwrap_or_else(detected);
+    // A concurrent `set_path` wins over the default.
+    let _ = PATH.compare_exchange(0, path.code(), Ordering::Relaxed, Ordering::Relaxed);
+    SimdPath::from_code(PATH.load(Ordering::Relaxed))
+}
+
+/// Makes every kernel of this process run on `path` from now on (for tests and benchmarks that
+/// compare paths). Renders never depend on the path, only their speed does.
+pub fn set_path(path: SimdPath) -> Result<(), UnsupportedPath> {
+    if !path.is_supported() {
+        return Err(UnsupportedPath(path));
+    }
+    PATH.store(path.code(), Ordering::Relaxed);
+    Ok(())
+}
+
+/// [`set_path`] was asked for a path this processor cannot run.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("this processor cannot run the {} SIMD path", .0.name())]
+pub struct UnsupportedPath(pub SimdPath);
+
+/// A kernel: code generic over the instruction set, run by [`dispatch`]. `run` must be
+/// `#[inline(always)]`, and so must every generic function it calls, so that the whole kernel is
+/// compiled inside the trampoline that enables the path's instructions.
+pub trait Kernel {
+    type Output;
+    fn run<I: Isa>(self) -> Self::Output;
+}
+
+/// Runs `kernel` on the current [`path`].
+#[inline]
+pub fn dispatch<K: Kernel>(kernel: K) -> K::Output {
+    match path() {
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: `path()` only returns a path the processor supports.
+        SimdPath::Avx512 => unsafe { x86::run_avx512(kernel) },
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: as above.
+        SimdPath::Avx2 => unsafe { x86::run_avx2(kernel) },
+        _ => kernel.run::<Portable>(),
+    }
+}
+
+/// An instruction set: the lane types its kernels use. Implemented only by tokens that
+/// [`dispatch`] hands to kernels compiled for them.
+pub trait Isa: Copy + 'static {
+    type F32x4: Lanes<Elem = f32>;
+    type F32x8: Lanes<Elem = f32>;
+    type F64x4: Lanes<Elem = f64>;
+    type F64x8: Lanes<Elem = f64>;
+    /// Each lane converted exactly to `f64`.
+    fn widen(x: Self::F32x4) -> Self::F64x4;
+    /// Each lane rounded to the nearest `f32`.
+    fn narrow(x: Self::F64x4) -> Self::F32x4;
+}
+
+/// `N` floating-point lanes with the same operation applied to each.
+pub trait Lanes:
+    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self> + Neg<Output = Self>
+{
+    type Elem: Copy;
+    type Mask: MaskOps;
+    const N: usize;
+    fn splat(value: Self::Elem) -> Self;
+    /// The first `N` values of `values`.
+    fn load(values: &[Self::Elem]) -> Self;
+    fn store(self, out: &mut [Self::Elem]);
+    fn sqrt(self) -> Self;
+    fn abs(self) -> Self;
+    /// `self > other ? self : other` per lane (x86's `max`): a NaN in either gives `other`.
+    fn max(self, other: Self) -> Self;
+    /// `self < other ? self : other` per lane (x86's `min`): a NaN in either gives `other`.
+    fn min(self, other: Self) -> Self;
+    fn lt(self, other: Self) -> Self::Mask;
+    fn le(self, other: Self) -> Self::Mask;
+    fn gt(self, other: Self) -> Self::Mask;
+    fn eq(self, other: Self) -> Self::Mask;
+    /// Lanes that are NaN.
+    fn is_nan(self) -> Self::Mask;
+    /// `mask ? if_true : if_false` per lane.
+    fn select(mask: Self::Mask, if_true: Self, if_false: Self) -> Self;
+}
+
+/// A true/false flag per lane, the result of comparing [`Lanes`].
+pub trait MaskOps: Copy {
+    fn and(self, other: Self) -> Self;
+    fn or(self, other: Self) -> Self;
+    /// `self && !other`.
+    fn and_not(self, other: Self) -> Self;
+    /// Bit `i` set when lane `i` is true.
+    fn bits(self) -> u32;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    struct Probe;
+
+    impl Kernel for Probe {
+        type Output = ([f32; 8], u32, [f32; 4], [f64; 4], u32);
+        #[inline(always)]
+        fn run<I: Isa>(self) -> Self::Output {
+            let a = I::F32x8::load(&[1.0, -2.0, f32::NAN, 4.0, 0.0, -0.0, 7.0, f32::INFINITY]);
+            let b = I::F32x8::splat(0.5);
+            let mut max = [0.0; 8];
+            a.max(b).store(&mut max);
+            let bits = a.gt(b).or(a.is_nan()).bits();
+            let x = I::F32x4::load(&[1.5, 2.0, 3.0, 1.0e-40]);
+            let wide = I::widen(x) * I::widen(x);
+            let mut narrow = [0.0; 4];
+            I::narrow(wide).store(&mut narrow);
+            let mut sums = [0.0; 4];
+            I::F64x4::select(wide.le(I::F64x4::splat(3.0)), wide, -wide)
+                .sqrt()
+                .store(&mut sums);
+            (
+                max,
+                bits,
+                narrow,
+                sums,
+                x.lt(I::F32x4::splat(2.0)).and_not(x.eq(x.abs())).bits(),
+            )
+        }
+    }
+
+    #[test]
+    fn every_available_path_computes_the_same_lanes() {
+        let portable = Probe.run::<Portable>();
+        assert_eq!(portable.0[2], 0.5, "NaN gives the second operand");
+        assert_eq!(portable.1, 0b1100_1101);
+        #[cfg(target_arch = "x86_64")]
+        {
+            // SAFETY: each trampoline runs only where the processor supports it.
+            let results = [
+                x86::has_avx2().then(|| unsafe { x86::run_avx2(Probe) }),
+                x86::has_avx512().then(|| unsafe { x86::run_avx512(Probe) }),
+            ];
+            for result in results.into_iter().flatten() {
+                assert_eq!(format!("{result:?}"), format!("{portable:?}"));
+            }
+        }
+    }
+
+    #[test]
+    fn paths_are_named_and_the_portable_one_always_runs() {
+        assert_eq!(SimdPath::from_name(" AVX2 "), Some(SimdPath::Avx2));
+        assert!(available().contains(&SimdPath::Portable));
+        assert!(available().contains(&detected()));
+    }
+}

@@ -1,0 +1,364 @@
+//! The x86-64 paths: lanes in SSE/AVX registers, kernels compiled with AVX2 or AVX-512 enabled.
+//!
+//! Both paths use the same lane types (128- and 256-bit registers); the AVX-512 path compiles
+//! the kernels with AVX-512 enabled as well, which lets the compiler use its extra registers and
+//! mask instructions. Every operation here is the IEEE operation of the portable path, lane by
+//! lane: the comparisons are the ordered, quiet predicates Rust's `<`, `<=`, `>` and `==` are, and
+//! `max`/`min` are the instructions whose rule the portable path copies.
+
+use std::arch::x86_64::*;
+use std::ops::{Add, Div, Mul, Neg, Sub};
+
+use super::{Isa, Kernel, Lanes, MaskOps};
+
+pub(super) fn has_avx2() -> bool {
+    is_x86_feature_detected!("avx2")
+        && is_x86_feature_detected!("fma")
+        && is_x86_feature_detected!("bmi1")
+        && is_x86_feature_detected!("bmi2")
+        && is_x86_feature_detected!("lzcnt")
+        && is_x86_feature_detected!("popcnt")
+}
+
+pub(super) fn has_avx512() -> bool {
+    has_avx2()
+        && is_x86_feature_detected!("avx512f")
+        && is_x86_feature_detected!("avx512vl")
+        && is_x86_feature_detected!("avx512bw")
+        && is_x86_feature_detected!("avx512dq")
+        && is_x86_feature_detected!("avx512cd")
+}
+
+/// # Safety
+/// The processor must support AVX2 ([`has_avx2`]).
+#[target_feature(enable = "avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
+pub(super) unsafe fn run_avx2<K: Kernel>(kernel: K) -> K::Output {
+    kernel.run::<Avx2>()
+}
+
+/// # Safety
+/// The processor must support AVX-512 ([`has_avx512`]).
+#[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq,avx512cd,avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
+pub(super) unsafe fn run_avx512<K: Kernel>(kernel: K) -> K::Output {
+    kernel.run::<Avx512>()
+}
+
+/// The AVX2 instruction set. Only `run_avx2` names it, so its lanes only run where AVX2 does.
+#[derive(Clone, Copy, Debug)]
+pub struct Avx2(());
+
+/// The AVX-512 instruction set (same lanes as [`Avx2`], compiled with AVX-512 enabled).
+#[derive(Clone, Copy, Debug)]
+pub struct Avx512(());
+
+macro_rules! isa {
+    ($token:ty) => {
+        impl Isa for $token {
+            type F32x4 = F32x4;
+            type F32x8 = F32x8;
+            type F64x4 = F64x4;
+            type F64x8 = F64x8;
+
+            #[inline(always)]
+            fn widen(x: F32x4) -> F64x4 {
+                unsafe { F64x4(_mm256_cvtps_pd(x.0)) }
+            }
+
+            #[inline(always)]
+            fn narrow(x: F64x4) -> F32x4 {
+                unsafe { F32x4(_mm256_cvtpd_ps(x.0)) }
+            }
+        }
+    };
+}
+
+isa!(Avx2);
+isa!(Avx512);
+
+/// Defines a lane type over one register: its arithmetic, and its mask (a register of the same
+/// type whose lanes are all ones or all zeros).
+macro_rules! register_lanes {
+    (
+        $name:ident, $mask:ident, $reg:ty, $elem:ty, $n:expr,
+        load: $load:ident, store: $store:ident, splat: $splat:ident,
+        add: $add:ident, sub: $sub:ident, mul: $mul:ident, div: $div:ident, sqrt: $sqrt:ident,
+        max: $max:ident, min: $min:ident, and: $and:ident, or: $or:ident, andnot: $andnot:ident,
+        xor: $xor:ident, blend: $blend:ident, movemask: $movemask:ident,
+        cmp: |$a:ident, $b:ident, $pred:ident| $cmp:expr
+    ) => {
+        #[derive(Clone, Copy, Debug)]
+        pub struct $name($reg);
+
+        #[derive(Clone, Copy, Debug)]
+        pub struct $mask($reg);
+
+        impl $name {
+            #[inline(always)]
+            fn compare<const $pred: i32>(self, other: Self) -> $mask {
+                let ($a, $b) = (self.0, other.0);
+                $mask(unsafe { $cmp })
+            }
+        }
+
+        impl MaskOps for $mask {
+            #[inline(always)]
+            fn and(self, other: Self) -> Self {
+                $mask(unsafe { $and(self.0, other.0) })
+            }
+            #[inline(always)]
+            fn or(self, other: Self) -> Self {
+                $mask(unsafe { $or(self.0, other.0) })
+            }
+            #[inline(always)]
+            fn and_not(self, other: Self) -> Self {
+                $mask(unsafe { $andnot(other.0, self.0) })
+            }
+            #[inline(always)]
+            fn bits(self) -> u32 {
+                unsafe { $movemask(self.0) as u32 }
+            }
+        }
+
+        impl Add for $name {
+            type Output = Self;
+            #[inline(always)]
+            fn add(self, other: Self) -> Self {
+                $name(unsafe { $add(self.0, other.0) })
+            }
+        }
+
+        impl Sub for $name {
+            type Output = Self;
+            #[inline(always)]
+            fn sub(self, other: Self) -> Self {
+                $name(unsafe { $sub(self.0, other.0) })
+            }
+        }
+
+        impl Mul for $name {
+            type Output = Self;
+            #[inline(always)]
+            fn mul(self, other: Self) -> Self {
+                $name(unsafe { $mul(self.0, other.0) })
+            }
+        }
+
+        impl Div for $name {
+            type Output = Self;
+            #[inline(always)]
+            fn div(self, other: Self) -> Self {
+                $name(unsafe { $div(self.0, other.0) })
+            }
+        }
+
+        impl Neg for $name {
+            type Output = Self;
+            #[inline(always)]
+            fn neg(self) -> Self {
+                $name(unsafe { $xor(self.0, $splat(-0.0)) })
+            }
+        }
+
+        impl Lanes for $name {
+            type Elem = $elem;
+            type Mask = $mask;
+            const N: usize = $n;
+
+            #[inline(always)]
+            fn splat(value: $elem) -> Self {
+                $name(unsafe { $splat(value) })
+            }
+            #[inline(always)]
+            fn load(values: &[$elem]) -> Self {
+                let values = &values[..$n];
+                $name(unsafe { $load(values.as_ptr()) })
+            }
+            #[inline(always)]
+            fn store(self, out: &mut [$elem]) {
+                let out = &mut out[..$n];
+                unsafe { $store(out.as_mut_ptr(), self.0) }
+            }
+            #[inline(always)]
+            fn sqrt(self) -> Self {
+                $name(unsafe { $sqrt(self.0) })
+            }
+            #[inline(always)]
+            fn abs(self) -> Self {
+                $name(unsafe { $andnot($splat(-0.0), self.0) })
+            }
+            #[inline(always)]
+            fn max(self, other: Self) -> Self {
+                $name(unsafe { $max(self.0, other.0) })
+            }
+            #[inline(always)]
+            fn min(self, other: Self) -> Self {
+                $name(unsafe { $min(self.0, other.0) })
+            }
+            #[inline(always)]
+            fn lt(self, other: Self) -> $mask {
+                self.compare::<_CMP_LT_OQ>(other)
+            }
+            #[inline(always)]
+            fn le(self, other: Self) -> $mask {
+                self.compare::<_CMP_LE_OQ>(other)
+            }
+            #[inline(always)]
+            fn gt(self, other: Self) -> $mask {
+                self.compare::<_CMP_GT_OQ>(other)
+            }
+            #[inline(always)]
+            fn eq(self, other: Self) -> $mask {
+                self.compare::<_CMP_EQ_OQ>(other)
+            }
+            #[inline(always)]
+            fn is_nan(self) -> $mask {
+                self.compare::<_CMP_UNORD_Q>(self)
+            }
+            #[inline(always)]
+            fn select(mask: $mask, if_true: Self, if_false: Self) -> Self {
+                $name(unsafe { $blend(if_false.0, if_true.0, mask.0) })
+            }
+        }
+    };
+}
+
+register_lanes!(
+    F32x4, M32x4, __m128, f32, 4,
+    load: _mm_loadu_ps, store: _mm_storeu_ps, splat: _mm_set1_ps,
+    add: _mm_add_ps, sub: _mm_sub_ps, mul: _mm_mul_ps, div: _mm_div_ps, sqrt: _mm_sqrt_ps,
+    max: _mm_max_ps, min: _mm_min_ps, and: _mm_and_ps, or: _mm_or_ps, andnot: _mm_andnot_ps,
+    xor: _mm_xor_ps, blend: _mm_blendv_ps, movemask: _mm_movemask_ps,
+    cmp: |a, b, P| _mm_cmp_ps::<P>(a, b)
+);
+
+register_lanes!(
+    F32x8, M32x8, __m256, f32, 8,
+    load: _mm256_loadu_ps, store: _mm256_storeu_ps, splat: _mm256_set1_ps,
+    add: _mm256_add_ps, sub: _mm256_sub_ps, mul: _mm256_mul_ps, div: _mm256_div_ps, sqrt: _mm256_sqrt_ps,
+    max: _mm256_max_ps, min: _mm256_min_ps, and: _mm256_and_ps, or: _mm256_or_ps, andnot: _mm256_andnot_ps,
+    xor: _mm256_xor_ps, blend: _mm256_blendv_ps, movemask: _mm256_movemask_ps,
+    cmp: |a, b, P| _mm256_cmp_ps::<P>(a, b)
+);
+
+register_lanes!(
+    F64x4, M64x4, __m256d, f64, 4,
+    load: _mm256_loadu_pd, store: _mm256_storeu_pd, splat: _mm256_set1_pd,
+    add: _mm256_add_pd, sub: _mm256_sub_pd, mul: _mm256_mul_pd, div: _mm256_div_pd, sqrt: _mm256_sqrt_pd,
+    max: _mm256_max_pd, min: _mm256_min_pd, and: _mm256_and_pd, or: _mm256_or_pd, andnot: _mm256_andnot_pd,
+    xor: _mm256_xor_pd, blend: _mm256_blendv_pd, movemask: _mm256_movemask_pd,
+    cmp: |a, b, P| _mm256_cmp_pd::<P>(a, b)
+);
+
+/// Eight `f64` lanes as two halves of four.
+#[derive(Clone, Copy, Debug)]
+pub struct F64x8([F64x4; 2]);
+
+#[derive(Clone, Copy, Debug)]
+pub struct M64x8([M64x4; 2]);
+
+impl MaskOps for M64x8 {
+    #[inline(always)]
+    fn and(self, other: Self) -> Self {
+        M64x8([self.0[0].and(other.0[0]), self.0[1].and(other.0[1])])
+    }
+    #[inline(always)]
+    fn or(self, other: Self) -> Self {
+        M64x8([self.0[0].or(other.0[0]), self.0[1].or(other.0[1])])
+    }
+    #[inline(always)]
+    fn and_not(self, other: Self) -> Self {
+        M64x8([self.0[0].and_not(other.0[0]), self.0[1].and_not(other.0[1])])
+    }
+    #[inline(always)]
+    fn bits(self) -> u32 {
+        self.0[0].bits() | self.0[1].bits() << 4
+    }
+}
+
+macro_rules! halves_op {
+    ($trait:ident, $method:ident) => {
+        impl $trait for F64x8 {
+            type Output = Self;
+            #[inline(always)]
+            fn $method(self, other: Self) -> Self {
+                F64x8([self.0[0].$method(other.0[0]), self.0[1].$method(other.0[1])])
+            }
+        }
+    };
+}
+
+halves_op!(Add, add);
+halves_op!(Sub, sub);
+halves_op!(Mul, mul);
+halves_op!(Div, div);
+
+impl Neg for F64x8 {
+    type Output = Self;
+    #[inline(always)]
+    fn neg(self) -> Self {
+        F64x8([-self.0[0], -self.0[1]])
+    }
+}
+
+impl Lanes for F64x8 {
+    type Elem = f64;
+    type Mask = M64x8;
+    const N: usize = 8;
+
+    #[inline(always)]
+    fn splat(value: f64) -> Self {
+        F64x8([F64x4::splat(value); 2])
+    }
+    #[inline(always)]
+    fn load(values: &[f64]) -> Self {
+        F64x8([F64x4::load(&values[..4]), F64x4::load(&values[4..8])])
+    }
+    #[inline(always)]
+    fn store(self, out: &mut [f64]) {
+        self.0[0].store(&mut out[..4]);
+        self.0[1].store(&mut out[4..8]);
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        F64x8([self.0[0].sqrt(), self.0[1].sqrt()])
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        F64x8([self.0[0].abs(), self.0[1].abs()])
+    }
+    #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        F64x8([self.0[0].max(other.0[0]), self.0[1].max(other.0[1])])
+    }
+    #[inline(always)]
+    fn min(self, other: Self) -> Self {
+        F64x8([self.0[0].min(other.0[0]), self.0[1].min(other.0[1])])
+    }
+    #[inline(always)]
+    fn lt(self, other: Self) -> M64x8 {
+        M64x8([self.0[0].lt(other.0[0]), self.0[1].lt(other.0[1])])
+    }
+    #[inline(always)]
+    fn le(self, other: Self) -> M64x8 {
+        M64x8([self.0[0].le(other.0[0]), self.0[1].le(other.0[1])])
+    }
+    #[inline(always)]
+    fn gt(self, other: Self) -> M64x8 {
+        M64x8([self.0[0].gt(other.0[0]), self.0[1].gt(other.0[1])])
+    }
+    #[inline(always)]
+    fn eq(self, other: Self) -> M64x8 {
+        M64x8([self.0[0].eq(other.0[0]), self.0[1].eq(other.0[1])])
+    }
+    #[inline(always)]
+    fn is_nan(self) -> M64x8 {
+        M64x8([self.0[0].is_nan(), self.0[1].is_nan()])
+    }
+    #[inline(always)]
+    fn select(mask: M64x8, if_true: Self, if_false: Self) -> Self {
+        F64x8([
+            F64x4::select(mask.0[0], if_true.0[0], if_false.0[0]),
+            F64x4::select(mask.0[1], if_true.0[1], if_false.0[1]),
+        ])
+    }
+}
