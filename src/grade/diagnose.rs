@@ -146,6 +146,9 @@ pub struct RenderDiagnosis {
     pub rendered: usize,
     pub cached: usize,
     pub seconds: f64,
+    /// Fault sets that could not be rendered, with the reason; left out of the comparison.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub failed: Vec<String>,
 }
 
 /// Whether an image lost points on a comparison (a missing or unreadable file has nothing to
@@ -318,24 +321,26 @@ pub(super) fn diagnose_class(
         }
         let film = goldens.films[images[0]].clone();
         let store = pictures::FaultPictures::new(Some(cache.join("faults").join(key)), &source.case, &film, pictures);
-        let render_error = |error: crate::Error| GradeError::Golden {
-            location: source.location.clone(),
-            render: source.name.clone(),
-            source: Box::new(error),
+        // A fault set that cannot be rendered (it cannot, for the course's scenes) is left out
+        // and said in the run's record, rather than stopping the grading.
+        let failed = Mutex::new(Vec::new());
+        let get = |set: FaultSet| match store.get(&set) {
+            Ok(pictures) => Some(Candidate { set, pictures }),
+            Err(error) => {
+                failed
+                    .lock()
+                    .unwrap_or_else(|p| p.into_inner())
+                    .push(format!("{set}: {error}"));
+                None
+            }
         };
         let golden_pictures = store.golden();
         // Where the golden primary rays hit nothing (the background shows).
         let misses: Vec<bool> = store.golden_film().depth.iter().map(|t| *t == f32::INFINITY).collect();
         let singles: Vec<Candidate> = candidates::singles(&source.case, store.pictures())
             .into_iter()
-            .map(|set| {
-                Ok(Candidate {
-                    set,
-                    pictures: store.get(&set)?,
-                })
-            })
-            .collect::<Result<_, crate::Error>>()
-            .map_err(render_error)?;
+            .filter_map(get)
+            .collect();
 
         // The students' pictures and their singles' scores, in parallel.
         let subjects: Vec<Option<Subject>> = failing
@@ -384,16 +389,7 @@ pub(super) fn diagnose_class(
                 }
             }
         }
-        let expanded: Vec<Candidate> = wanted
-            .into_iter()
-            .map(|set| {
-                Ok(Candidate {
-                    set,
-                    pictures: store.get(&set)?,
-                })
-            })
-            .collect::<Result<_, crate::Error>>()
-            .map_err(render_error)?;
+        let expanded: Vec<Candidate> = wanted.into_iter().filter_map(get).collect();
 
         let decided: Vec<Option<(Diagnosis, usize, usize)>> = failing
             .par_iter()
@@ -436,6 +432,7 @@ pub(super) fn diagnose_class(
             rendered,
             cached: store.cached.load(std::sync::atomic::Ordering::Relaxed),
             seconds: render_started.elapsed().as_secs_f64(),
+            failed: failed.into_inner().unwrap_or_else(|p| p.into_inner()),
         });
     }
     progress.finish();

@@ -218,8 +218,16 @@ pub fn summary(report: &ClassReport, out: &Path) -> String {
     }
     let counts: Vec<String> = counts.iter().map(|(word, n)| format!("{n} {word}")).collect();
     let rendered = report.goldens.iter().filter(|g| !g.cached).count();
+    let diagnosis = report.diagnosis.as_ref().map_or(String::new(), |run| {
+        let renders: usize = run.renders.iter().map(|r| r.rendered).sum();
+        let cached: usize = run.renders.iter().map(|r| r.cached).sum();
+        format!(
+            "\ndiagnosed {} images that lost points: {} explained by a known mistake ({renders} mistake renders, {cached} cached, {:.1} s)",
+            run.images, run.explained, run.seconds
+        )
+    });
     format!(
-        "graded {} students on {} images ({}); {} golden renders ({rendered} rendered, {} cached in {})\nreport: {}",
+        "graded {} students on {} images ({}); {} golden renders ({rendered} rendered, {} cached in {}){diagnosis}\nreport: {}",
         report.students.len(),
         report.rubric.images.len(),
         if counts.is_empty() {
