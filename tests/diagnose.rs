@@ -51,7 +51,7 @@ enum Perturbation {
 }
 
 /// One renderer per render of the rubric, each building its scenes once for every student.
-fn renderers(rubric: &goldray::grade::Rubric, perturbation: Perturbation) -> Vec<FaultRenderer> {
+fn renderers_for(rubric: &goldray::grade::Rubric, perturbation: Perturbation) -> Vec<FaultRenderer> {
     rubric
         .renders
         .iter()
@@ -171,7 +171,7 @@ fn grade(name: &str, perturbation: Perturbation) -> Graded {
     let rubric_path = course_rubric(&dir);
     let rubric = load_rubric(&rubric_path).unwrap();
     let submissions = dir.join("submissions");
-    let renderers = renderers(&rubric, perturbation);
+    let renderers = renderers_for(&rubric, perturbation);
     let mut made = BTreeMap::new();
     let mut students: Vec<(String, FaultSet)> = catalogue().into_iter().map(|s| (s.to_string(), s)).collect();
     students.extend(PAIRS.iter().map(|p| (p.replace('+', " + "), p.parse().unwrap())));
@@ -189,6 +189,30 @@ fn grade(name: &str, perturbation: Perturbation) -> Graded {
             fs::write(folder.join(&spec.file), encode_png(&noise(&picture, 3)).unwrap()).unwrap();
         }
         made.insert("noisy".to_owned(), FaultSet::NONE);
+        // The golden pictures rendered again on one thread, and re-encoded by another encoder.
+        let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+        let single = renderers_for(&rubric, Perturbation::None);
+        one_thread.install(|| {
+            write_student(
+                &rubric,
+                &single,
+                &FaultSet::NONE,
+                Perturbation::None,
+                &submissions.join("one-thread"),
+            )
+        });
+        made.insert("one-thread".to_owned(), FaultSet::NONE);
+        let reencoded = submissions.join("re-encoded");
+        fs::create_dir_all(&reencoded).unwrap();
+        for spec in &rubric.images {
+            let picture = image::open(submissions.join("correct").join(&spec.file))
+                .unwrap()
+                .into_rgba8();
+            picture
+                .save_with_format(reencoded.join(&spec.file), image::ImageFormat::Png)
+                .unwrap();
+        }
+        made.insert("re-encoded".to_owned(), FaultSet::NONE);
     }
     // One cache for both classes: the mistakes' pictures are rendered once.
     let cache = Path::new(env!("CARGO_TARGET_TMPDIR")).join("diagnose-cache");
@@ -364,7 +388,7 @@ fn two_faults_at_once_name_at_least_one_and_nothing_else() {
 #[test]
 fn correct_and_noisy_submissions_get_no_mistake() {
     let graded = exact();
-    for name in ["correct", "noisy"] {
+    for name in ["correct", "noisy", "one-thread", "re-encoded"] {
         for image in &student(graded, name).images {
             let diagnosis = image.diagnosis.as_ref().map(|d| d.id.as_str());
             assert!(
@@ -374,12 +398,33 @@ fn correct_and_noisy_submissions_get_no_mistake() {
             );
         }
     }
-    assert!(
-        student(graded, "correct")
-            .images
-            .iter()
-            .all(|i| i.diagnosis.is_none() && i.points == i.max_points)
-    );
+    for name in ["correct", "one-thread", "re-encoded"] {
+        let images = &student(graded, name).images;
+        assert!(
+            images.iter().all(|i| i.diagnosis.is_none() && i.points == i.max_points),
+            "{name}"
+        );
+    }
+}
+
+/// The starter code's output: every colour image its flat material colours.
+#[test]
+fn the_starter_codes_flat_colours_are_nothing_shaded() {
+    let graded = exact();
+    let colour: Vec<_> = student(graded, "nothing-shaded")
+        .images
+        .iter()
+        .filter(|i| !i.file.ends_with("n.png") && !i.file.ends_with("d.png"))
+        .collect();
+    assert_eq!(colour.len(), 7);
+    for image in colour {
+        assert_eq!(
+            image.diagnosis.as_ref().map(|d| d.id.as_str()),
+            Some("nothing-shaded"),
+            "{}",
+            image.file
+        );
+    }
 }
 
 #[test]
@@ -520,7 +565,7 @@ fn a_rubric_can_grant_credit_per_mistake() {
     }
     let plain = course_rubric(&dir);
     let rubric = load_rubric(&plain).unwrap();
-    let renderers = renderers(&rubric, Perturbation::None);
+    let renderers = renderers_for(&rubric, Perturbation::None);
     let submissions = dir.join("submissions");
     write_student(
         &rubric,
