@@ -691,33 +691,49 @@ impl FaultSet {
     pub fn explain(&self) -> String {
         let parts: Vec<String> = self
             .faults()
-            .map(|fault| {
-                let member = match fault {
-                    Fault::GammaApplied => match self.gamma {
-                        Gamma::Srgb => "the sRGB curve".to_owned(),
-                        Gamma::Power(g) => format!("γ = {}", short(g)),
-                    },
-                    Fault::SpecularUnnormalizedReflection => match self.length {
-                        Length::Factor(k) => format!("|R| ≈ {}", short(k)),
-                        Length::HitDistance => "|R| = the hit distance".to_owned(),
-                    },
-                    Fault::PixelMapping => match self.mapping {
-                        Mapping::Centres => "pixel centres at (x + ½)/w".to_owned(),
-                        Mapping::UpsideDown => "upside down".to_owned(),
-                        Mapping::Mirrored => "mirrored left to right".to_owned(),
-                    },
-                    Fault::CubemapFaceFlipped => match self.flip {
-                        Flip::Vertical => "rows reversed".to_owned(),
-                        Flip::Horizontal => "columns reversed".to_owned(),
-                    },
-                    Fault::WrongBounces => format!("{} bounce(s)", self.bounces),
-                    Fault::CubemapIgnored => {
-                        let [r, g, b] = self.background.map(|c| short(f64::from(c) / 255.0));
-                        format!("the colour {r} {g} {b}")
+            .map(|fault| match fault {
+                Fault::GammaApplied => match self.gamma {
+                    Gamma::Srgb => {
+                        "the sRGB curve is applied before writing; the course writes linear values".to_owned()
                     }
-                    _ => return fault.explanation().to_owned(),
-                };
-                format!("{} ({member})", fault.explanation())
+                    Gamma::Power(g) => {
+                        format!(
+                            "a gamma of {} is applied before writing; the course writes linear values",
+                            short(g)
+                        )
+                    }
+                },
+                Fault::SpecularUnnormalizedReflection => {
+                    let length = match self.length {
+                        Length::Factor(k) => format!("about {} long", short(k)),
+                        Length::HitDistance => "as long as the hit distance".to_owned(),
+                    };
+                    format!(
+                        "your specular highlight uses R·V with R not normalised ({length}): highlights come out the \
+                             wrong size and brightness"
+                    )
+                }
+                Fault::PixelMapping => match self.mapping {
+                    Mapping::Centres => "pixel centres are placed at (x + ½)/w instead of the course's x/(w − 1)",
+                    Mapping::UpsideDown => "the picture is upside down: its rows are not flipped when saving",
+                    Mapping::Mirrored => "the picture is mirrored left to right (horizontal = up × direction)",
+                }
+                .to_owned(),
+                Fault::CubemapFaceFlipped => match self.flip {
+                    Flip::Vertical => "cube-map faces are read upside down (texel rows reversed)",
+                    Flip::Horizontal => "cube-map faces are read mirrored (texel columns reversed)",
+                }
+                .to_owned(),
+                Fault::WrongBounces => format!(
+                    "the recursion stops after {} bounce{}, not after the number -bounces asks for",
+                    self.bounces,
+                    if self.bounces == 1 { "" } else { "s" }
+                ),
+                Fault::CubemapIgnored => {
+                    let [r, g, b] = self.background.map(|c| short(f64::from(c) / 255.0));
+                    format!("the cube map is ignored: rays that miss see the colour ({r}, {g}, {b})")
+                }
+                _ => fault.explanation().to_owned(),
             })
             .collect();
         if parts.is_empty() {
