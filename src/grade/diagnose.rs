@@ -312,15 +312,28 @@ pub(super) fn diagnose_class(
         let render_started = Instant::now();
         let source = &rubric.renders[rubric.images[images[0]].render_index];
         progress.step(&format!("diagnosing images of {}", source.name));
-        let mut pictures: Vec<Picture> = Vec::new();
-        for &i in &images {
-            let picture = film_picture(rubric.images[i].output);
-            if !pictures.contains(&picture) {
-                pictures.push(picture);
+        // The pictures compared: those of the images that lost points; every picture of the
+        // render is cached, for the gradings to come.
+        let distinct = |images: &mut dyn Iterator<Item = usize>| {
+            let mut pictures: Vec<Picture> = Vec::new();
+            for i in images {
+                let picture = film_picture(rubric.images[i].output);
+                if !pictures.contains(&picture) {
+                    pictures.push(picture);
+                }
             }
-        }
+            pictures
+        };
+        let pictures = distinct(&mut failing.iter().map(|&(_, i)| i));
+        let stored = distinct(&mut images.iter().copied());
         let film = goldens.films[images[0]].clone();
-        let store = pictures::FaultPictures::new(Some(cache.join("faults").join(key)), &source.case, &film, pictures);
+        let store = pictures::FaultPictures::new(
+            Some(cache.join("faults").join(key)),
+            &source.case,
+            &film,
+            pictures,
+            stored,
+        );
         // A fault set that cannot be rendered (it cannot, for the course's scenes) is left out
         // and said in the run's record, rather than stopping the grading.
         let failed = Mutex::new(Vec::new());
@@ -337,8 +350,9 @@ pub(super) fn diagnose_class(
         let golden_pictures = store.golden();
         // Where the golden primary rays hit nothing (the background shows).
         let misses: Vec<bool> = store.golden_film().depth.iter().map(|t| *t == f32::INFINITY).collect();
+        // Read or rendered side by side: decoding cached pictures is most of a warm run's cost.
         let singles: Vec<Candidate> = candidates::singles(&source.case, store.pictures())
-            .into_iter()
+            .into_par_iter()
             .filter_map(get)
             .collect();
 
@@ -389,7 +403,7 @@ pub(super) fn diagnose_class(
                 }
             }
         }
-        let expanded: Vec<Candidate> = wanted.into_iter().filter_map(get).collect();
+        let expanded: Vec<Candidate> = wanted.into_par_iter().filter_map(get).collect();
 
         let decided: Vec<Option<(Diagnosis, usize, usize)>> = failing
             .par_iter()

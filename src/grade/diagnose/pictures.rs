@@ -37,7 +37,11 @@ pub struct FaultPictures<'a> {
     renderer: FaultRenderer,
     golden: &'a Film,
     tonemap: Tonemap,
+    /// The pictures diagnosis compares (those of the images that lost points), in memory.
     pictures: Vec<Picture>,
+    /// Every picture the rubric takes from the render (a superset), written to the cache when a
+    /// set is rendered, so that a later grading finds whichever it needs.
+    stored: Vec<Picture>,
     memo: Mutex<HashMap<String, Arc<Vec<RgbImage>>>>,
     /// The last films rendered, by render part, so that a render fault paired with PNG faults
     /// is quantised again rather than rendered again.
@@ -48,14 +52,22 @@ pub struct FaultPictures<'a> {
 }
 
 impl<'a> FaultPictures<'a> {
-    /// `dir`: this render's cache folder, or `None` to cache nothing.
-    pub fn new(dir: Option<PathBuf>, case: &'a Case, golden: &'a Film, pictures: Vec<Picture>) -> Self {
+    /// `dir`: this render's cache folder, or `None` to cache nothing; `pictures` those compared,
+    /// `stored` every picture of the render the rubric uses.
+    pub fn new(
+        dir: Option<PathBuf>,
+        case: &'a Case,
+        golden: &'a Film,
+        pictures: Vec<Picture>,
+        stored: Vec<Picture>,
+    ) -> Self {
         FaultPictures {
             dir,
             renderer: FaultRenderer::new(case),
             golden,
             tonemap: case.render.tonemap,
             pictures,
+            stored,
             memo: Mutex::new(HashMap::new()),
             films: Mutex::new(Vec::new()),
             rendered: AtomicUsize::new(0),
@@ -79,6 +91,17 @@ impl<'a> FaultPictures<'a> {
             .collect()
     }
 
+    /// Every picture of the render quantised and written to the cache (best effort: a cache that
+    /// cannot be written costs a render next time, nothing more).
+    fn store_all(&self, label: &str, film: &Film, faults: &FaultSet) {
+        for picture in &self.stored {
+            let image = picture_with_faults(film, *picture, self.tonemap, faults);
+            if let (Some(path), Ok(bytes)) = (self.entry(label, *picture), encode_png(&image)) {
+                let _ = write_file_atomic(&path, &bytes);
+            }
+        }
+    }
+
     /// The pictures a program with `faults` writes, in the order of [`FaultPictures::pictures`]:
     /// from this run's memory, the cache, the golden film (PNG faults only) or a render.
     pub fn get(&self, faults: &FaultSet) -> Result<Arc<Vec<RgbImage>>, crate::Error> {
@@ -93,9 +116,8 @@ impl<'a> FaultPictures<'a> {
             cached
         } else {
             let film = self.film(&faults.render_part())?;
-            let pictures = self.quantise(&film, faults);
-            self.write_cache(&label, &pictures);
-            pictures
+            self.store_all(&label, &film, faults);
+            self.quantise(&film, faults)
         });
         self.lock().insert(label, pictures.clone());
         Ok(pictures)
@@ -159,14 +181,5 @@ impl<'a> FaultPictures<'a> {
                 (picture.dimensions() == (width, height)).then_some(picture)
             })
             .collect()
-    }
-
-    /// Best effort: a cache that cannot be written costs a render next time, nothing more.
-    fn write_cache(&self, label: &str, pictures: &[RgbImage]) {
-        for (picture, image) in self.pictures.iter().zip(pictures) {
-            if let (Some(path), Ok(bytes)) = (self.entry(label, *picture), encode_png(image)) {
-                let _ = write_file_atomic(&path, &bytes);
-            }
-        }
     }
 }
