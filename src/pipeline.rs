@@ -15,6 +15,9 @@ use crate::progress::{Progress, Silent};
 use crate::stats::{BuildStats, Phases, RayCounts, RenderStats};
 use crate::with_precision;
 
+mod faults;
+pub use faults::{FaultRenderer, case_with_faults, fault_applies, orthonormal_up, render_case_with_faults};
+
 /// What a command wrote, and the statistics of the render behind it.
 #[derive(Debug)]
 pub struct Rendered {

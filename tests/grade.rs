@@ -190,7 +190,15 @@ fn grades_csv_parses_back_to_the_report() {
     let header: Vec<&str> = rows[0].iter().map(String::as_str).collect();
     assert_eq!(
         header,
-        ["student", "color.png", "normals.png", "depth.png", "total", "flags"]
+        [
+            "student",
+            "color.png",
+            "normals.png",
+            "depth.png",
+            "total",
+            "flags",
+            "diagnoses"
+        ]
     );
     assert_eq!(rows.len(), report.students.len() + 1, "one row per student");
     let by_name: BTreeMap<&str, &Vec<String>> = rows[1..].iter().map(|r| (r[0].as_str(), r)).collect();
@@ -198,13 +206,23 @@ fn grades_csv_parses_back_to_the_report() {
         let row = by_name
             .get(s.name.as_str())
             .unwrap_or_else(|| panic!("{} has no row:\n{text}", s.name));
-        let numbers: Vec<f64> = row[1..row.len() - 1].iter().map(|v| v.parse().unwrap()).collect();
-        assert_eq!(row[row.len() - 1], goldray::grade::flags(s).join("; "), "{}", s.name);
+        let numbers: Vec<f64> = row[1..row.len() - 2].iter().map(|v| v.parse().unwrap()).collect();
+        assert_eq!(row[row.len() - 2], goldray::grade::flags(s).join("; "), "{}", s.name);
+        assert_eq!(
+            row[row.len() - 1],
+            goldray::grade::diagnoses_of(s).join("; "),
+            "{}",
+            s.name
+        );
         let points: Vec<f64> = s.images.iter().map(|i| i.points).collect();
         assert_eq!(numbers[..3], points[..], "{}", s.name);
         assert_eq!(numbers[3], s.total);
         assert!(numbers[..3].iter().zip(POINTS).all(|(p, max)| *p <= max));
     }
+    let diagnoses = |name: &str| by_name[name].last().unwrap().as_str();
+    assert_eq!(diagnoses("no_shadows"), "no-shadows");
+    assert_eq!(diagnoses("gamma"), "gamma-applied");
+    assert_eq!(diagnoses("perfect"), "");
     let json: serde_json::Value = serde_json::from_str(&fs::read_to_string(out.join("grades.json")).unwrap()).unwrap();
     assert_eq!(json["students"].as_array().unwrap().len(), report.students.len());
     assert_eq!(json["rubric"]["max_points"], 4.0);

@@ -53,7 +53,7 @@ pub fn normals_image(film: &Film, tonemap: Tonemap) -> RgbImage {
 ///
 /// Rows are quantised in parallel, straight into the image's bytes (pixel `i` is row-major, as
 /// [`Film::index`] numbers it).
-fn quantised_image(film: &Film, tonemap: Tonemap, value: impl Fn(usize) -> [f32; 3] + Sync) -> RgbImage {
+pub(super) fn quantised_image(film: &Film, tonemap: Tonemap, value: impl Fn(usize) -> [f32; 3] + Sync) -> RgbImage {
     /// Rows per parallel work item.
     const BAND_ROWS: usize = 16;
     /// Pixels whose values are gathered, then quantised together.

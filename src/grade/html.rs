@@ -9,6 +9,8 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+mod mistakes;
+
 use super::golden::GOLDEN_DIR;
 use super::outcome::Outcome;
 use super::report::{ClassReport, flags, format_points};
@@ -100,8 +102,9 @@ fn page(title: &str, body: &str) -> String {
     format!(
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
          <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
-         <title>{}</title>\n<style>{STYLE}</style>\n</head>\n<body>\n{body}<script>{SCRIPT}</script>\n</body>\n</html>\n",
-        escape(title)
+         <title>{}</title>\n<style>{STYLE}{}</style>\n</head>\n<body>\n{body}<script>{SCRIPT}</script>\n</body>\n</html>\n",
+        escape(title),
+        mistakes::STYLE
     )
 }
 
@@ -120,6 +123,7 @@ fn index(report: &ClassReport) -> String {
         escape(&rubric.path.display().to_string()),
         report.goldray,
     );
+    mistakes::histogram(&mut body, report);
     // The student column stays put while the per-image cells scroll; the summary before them
     // names the images that lost points, so a wide rubric never hides a failure off screen.
     body.push_str(
@@ -323,6 +327,7 @@ fn student_page(report: &ClassReport, student: &StudentResult) -> String {
         );
     }
     body.push_str("</nav>\n");
+    mistakes::summary(&mut body, student);
     // Lost points first, the largest share lost first; rubric order among equals.
     let mut order: Vec<&ImageResult> = student.images.iter().collect();
     order.sort_by(|a, b| earned(a).total_cmp(&earned(b)));
@@ -351,6 +356,7 @@ fn image_section(body: &mut String, result: &ImageResult) {
     for flag in &result.flags {
         let _ = writeln!(body, "<p><span class=\"flag\">{}</span></p>", escape(flag));
     }
+    mistakes::image_line(body, result);
     if !result.notes.is_empty() {
         body.push_str("<ul>");
         for note in &result.notes {

@@ -20,6 +20,7 @@
 //! # }
 //! ```
 
+mod diagnose;
 mod error;
 mod golden;
 mod html;
@@ -39,11 +40,15 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use rayon::prelude::*;
 
 use crate::progress::Progress;
+pub use diagnose::{
+    Closest, Confidence, Diagnosis, DiagnosisRun, FAILING_REDUCTION, MISTAKES_DIR, RMSE_REDUCTION, RenderDiagnosis,
+    Residual, UNEXPLAINED, explains, loses_points,
+};
 pub use error::{GradeError, RubricError};
 pub use golden::{GoldenRender, Goldens, default_cache_dir, prepare_goldens};
 pub use integrity::{Integrity, LinkPolicy, PUBLISHED_COPY};
 pub use outcome::Outcome;
-pub use report::{ClassReport, RubricSummary, flags};
+pub use report::{ClassReport, RubricSummary, diagnoses_of, flags, mistakes_of};
 pub use rubric::{ImageSpec, Output, RenderSource, Rubric, Rule, load_rubric, parse_rubric};
 pub use score::{ImageResult, StudentResult, Submission, grade_image, judge};
 use similarity::similar_pairs;
@@ -57,14 +62,33 @@ pub struct GradeOptions {
     pub cache: Option<PathBuf>,
 }
 
+/// Whether grading names the mistake behind each image that lost points (see [`Diagnosis`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Diagnose {
+    Yes,
+    No,
+}
+
 /// Loads the rubric, prepares the goldens, grades every student folder of `submissions` on the
-/// current rayon pool and writes the whole report. Golden renders, then graded students, are
-/// reported to `progress`. Returns an error only when grading could not run; what students
-/// handed in never makes it fail.
+/// current rayon pool, diagnoses the images that lost points and writes the whole report.
+/// Golden renders, then graded students, then diagnosed images are reported to `progress`.
+/// Returns an error only when grading could not run; what students handed in never makes it
+/// fail.
 pub fn grade_class(
     rubric_path: &Path,
     submissions: &Path,
     options: &GradeOptions,
+    progress: &dyn Progress,
+) -> Result<ClassReport, GradeError> {
+    grade_class_diagnosing(rubric_path, submissions, options, Diagnose::Yes, progress)
+}
+
+/// [`grade_class`], diagnosing or not.
+pub fn grade_class_diagnosing(
+    rubric_path: &Path,
+    submissions: &Path,
+    options: &GradeOptions,
+    diagnose: Diagnose,
     progress: &dyn Progress,
 ) -> Result<ClassReport, GradeError> {
     let rubric = load_rubric(rubric_path)?;
@@ -110,10 +134,18 @@ pub fn grade_class(
         .collect::<Result<Vec<_>, _>>()?;
     progress.finish();
     let mut results = results.into_iter();
-    let students: Vec<StudentResult> = folders
+    let mut students: Vec<StudentResult> = folders
         .iter()
         .map(|submission| StudentResult::new(submission, results.by_ref().take(per_student).collect()))
         .collect();
+    let diagnosis = if diagnose == Diagnose::Yes {
+        let run = diagnose::diagnose_class(&rubric, &goldens, &cache, &mut students, out, progress)?;
+        diagnose::prefer_consistent(&mut students);
+        diagnose::apply_credit(&rubric, &mut students);
+        Some(run)
+    } else {
+        None
+    };
     let similar = similar_pairs(
         &students
             .iter()
@@ -137,6 +169,7 @@ pub fn grade_class(
         submissions: submissions.to_path_buf(),
         cache: cache.clone(),
         goldens: goldens.renders,
+        diagnosis,
         ignored,
         students,
         similar,

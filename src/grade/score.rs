@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
+use super::diagnose::Diagnosis;
 use super::golden::GOLDEN_DIR;
 use super::integrity::{Integrity, PUBLISHED_COPY, pixel_hash, refuse_link};
 use super::outcome::Outcome;
@@ -34,6 +35,10 @@ pub struct ImageResult {
     /// The diff heatmap, relative to the report directory.
     pub diff_image: Option<String>,
     pub metrics: Option<Metrics>,
+    /// Which mistake explains the image, only for an image that lost points on a comparison
+    /// (and only when grading diagnoses).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub diagnosis: Option<Diagnosis>,
     /// Evidence for the TA about where the picture came from ("identical to the published
     /// reference"); it changes the points only where the rubric says so.
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -94,6 +99,11 @@ impl StudentResult {
             images,
         }
     }
+
+    /// The total again, after points changed (credit for a diagnosed mistake).
+    pub fn recount(&mut self) {
+        self.total = self.images.iter().map(|i| i.points).sum();
+    }
 }
 
 /// Grades one expected image of one submission against its golden picture, writing the student's
@@ -121,6 +131,7 @@ pub fn grade_image(
         student_image: None,
         diff_image: None,
         metrics: None,
+        diagnosis: None,
         flags: Vec::new(),
         fingerprint: None,
     };
