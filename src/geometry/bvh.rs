@@ -418,10 +418,20 @@ pub fn traverse<I: Isa>(
                 let mut t = [0.0; WIDTH];
                 t_enter.store(&mut t);
                 let child = |lane: usize| Pending { t: t[lane], index: node.child[lane], count: node.count[lane] };
+                // A child that waits on the stack is fetched from memory meanwhile.
+                let fetch = |pending: &Pending| {
+                    if pending.count == 0 {
+                        let waiting: *const BvhNode = &nodes[pending.index as usize];
+                        for line in 0..size_of::<BvhNode>().div_ceil(64) {
+                            I::prefetch(waiting.cast::<u8>().wrapping_add(64 * line));
+                        }
+                    }
+                };
                 if rest & (rest - 1) == 0 {
                     // Two children, the common case: the farther one waits.
                     let second = rest.trailing_zeros() as usize;
                     let (near, far) = if t[second] < t[first] { (second, first) } else { (first, second) };
+                    fetch(&child(far));
                     stack.push(child(far));
                     current = child(near);
                     continue;
@@ -443,7 +453,9 @@ pub fn traverse<I: Isa>(
                     len += 1;
                 }
                 for &key in keys[1..len].iter().rev() {
-                    stack.push(child(key as usize & (WIDTH - 1)));
+                    let waiting = child(key as usize & (WIDTH - 1));
+                    fetch(&waiting);
+                    stack.push(waiting);
                 }
                 current = child(keys[0] as usize & (WIDTH - 1));
                 continue;

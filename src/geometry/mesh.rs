@@ -4,6 +4,7 @@
 use std::time::{Duration, Instant};
 
 use super::aabb::Aabb;
+use super::huge_page_vec;
 use super::bvh::{Bvh, LeafCost, Visit, traverse};
 use super::triangle::{
     PackRay, TriangleHit, TrianglePack, face_normal, intersect_pack, lane_hit, normalize, triangle_surface,
@@ -239,7 +240,8 @@ fn pack_leaves(bvh: &mut Bvh, corners: &[[Vec3; 3]]) -> Vec<TrianglePack> {
         first_pack[first as usize] = packed;
         packed += count.div_ceil(4);
     }
-    let packs = leaves
+    let mut packs = huge_page_vec(packed as usize);
+    let all = leaves
         .par_iter()
         .flat_map_iter(|&(first, count)| {
             (first..first + count).step_by(4).map(move |start| {
@@ -250,8 +252,8 @@ fn pack_leaves(bvh: &mut Bvh, corners: &[[Vec3; 3]]) -> Vec<TrianglePack> {
                 }
                 TrianglePack::new(&lanes[..(end - start) as usize])
             })
-        })
-        .collect();
+        });
+    packs.par_extend(all);
     bvh.remap_leaves(|first, count| (first_pack[first as usize], count.div_ceil(4)));
     packs
 }

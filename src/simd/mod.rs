@@ -164,6 +164,9 @@ pub trait Isa: Copy + 'static {
     fn widen(x: Self::F32x4) -> Self::F64x4;
     /// Each lane rounded to the nearest `f32`.
     fn narrow(x: Self::F64x4) -> Self::F32x4;
+    /// Asks for the cache line holding `address` to be loaded, without waiting for it (a hint
+    /// that changes no result; nothing on the portable path).
+    fn prefetch<T>(address: *const T);
 }
 
 /// `N` floating-point lanes with the same operation applied to each.

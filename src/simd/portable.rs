@@ -23,6 +23,9 @@ impl Isa for Portable {
     fn narrow(x: Array<f64, 4>) -> Array<f32, 4> {
         Array(x.0.map(|v| v as f32))
     }
+
+    #[inline(always)]
+    fn prefetch<T>(_: *const T) {}
 }
 
 /// `N` lanes of `T`.

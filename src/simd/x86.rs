@@ -68,6 +68,12 @@ macro_rules! isa {
             fn narrow(x: F64x4) -> F32x4 {
                 unsafe { F32x4(_mm256_cvtpd_ps(x.0)) }
             }
+
+            #[inline(always)]
+            fn prefetch<T>(address: *const T) {
+                // SAFETY: a prefetch never faults, whatever the address.
+                unsafe { _mm_prefetch::<_MM_HINT_T0>(address.cast()) }
+            }
         }
     };
 }
