@@ -188,6 +188,9 @@ pub enum Parameter {
     Length(Length),
     Mapping(Mapping),
     Flip(Flip),
+    /// `cubemap-ignored=rrggbb`: the flat colour a miss shows instead of the cube map, in
+    /// 8-bit codes (the course writes linear values, so a code is the colour times 255).
+    Background([u8; 3]),
     /// `wrong-bounces=n`: the recursion stops after `n` reflections instead of the command's.
     Bounces(u32),
 }
@@ -381,6 +384,7 @@ impl Fault {
                 | Fault::PixelMapping
                 | Fault::GammaApplied
                 | Fault::CubemapFaceFlipped
+                | Fault::CubemapIgnored
         )
     }
 
@@ -419,6 +423,7 @@ pub struct FaultSet {
     mapping: Mapping,
     flip: Flip,
     bounces: u32,
+    background: [u8; 3],
 }
 
 impl Default for FaultSet {
@@ -435,6 +440,7 @@ impl FaultSet {
         mapping: Mapping::Centres,
         flip: Flip::Vertical,
         bounces: 0,
+        background: [0; 3],
     };
 
     /// One fault, a family's with its first member (`gamma-applied=srgb`,
@@ -475,6 +481,10 @@ impl FaultSet {
                 self.bounces = bounces;
                 Fault::WrongBounces
             }
+            Parameter::Background(color) => {
+                self.background = color;
+                Fault::CubemapIgnored
+            }
         };
         self.and(fault)
     }
@@ -511,6 +521,11 @@ impl FaultSet {
             } else {
                 none.bounces
             },
+            background: if has(Fault::CubemapIgnored) {
+                self.background
+            } else {
+                none.background
+            },
         }
     }
 
@@ -532,6 +547,7 @@ impl FaultSet {
                 Fault::PixelMapping => Some(Parameter::Mapping(self.mapping)),
                 Fault::CubemapFaceFlipped => Some(Parameter::Flip(self.flip)),
                 Fault::WrongBounces => Some(Parameter::Bounces(self.bounces)),
+                Fault::CubemapIgnored => Some(Parameter::Background(self.background)),
                 _ => None,
             })
             .collect()
@@ -568,6 +584,11 @@ impl FaultSet {
 
     pub fn flip(&self) -> Flip {
         self.flip
+    }
+
+    /// The colour of `cubemap-ignored=rrggbb`, linear.
+    pub fn background(&self) -> [f64; 3] {
+        self.background.map(|c| f64::from(c) / 255.0)
     }
 
     /// `n` of `wrong-bounces=n`, when the set has it.
@@ -650,6 +671,7 @@ impl FaultSet {
             }
             .to_owned(),
             Fault::WrongBounces => self.bounces.to_string(),
+            Fault::CubemapIgnored => self.background.iter().map(|c| format!("{c:02x}")).collect(),
             _ => return fault.name().to_owned(),
         };
         format!("{}={value}", fault.name())
@@ -689,6 +711,10 @@ impl FaultSet {
                         Flip::Horizontal => "columns reversed".to_owned(),
                     },
                     Fault::WrongBounces => format!("{} bounce(s)", self.bounces),
+                    Fault::CubemapIgnored => {
+                        let [r, g, b] = self.background.map(|c| short(f64::from(c) / 255.0));
+                        format!("the colour {r} {g} {b}")
+                    }
                     _ => return fault.explanation().to_owned(),
                 };
                 format!("{} ({member})", fault.explanation())
@@ -793,6 +819,12 @@ impl FromStr for FaultSet {
                     Ok(n) if n <= 1024 => Parameter::Bounces(n),
                     _ => return Err(bad("a whole number from 0 to 1024")),
                 },
+                Fault::CubemapIgnored => match u32::from_str_radix(value, 16) {
+                    Ok(rgb) if value.len() == 6 => {
+                        Parameter::Background([(rgb >> 16) as u8, (rgb >> 8) as u8, rgb as u8])
+                    }
+                    _ => return Err(bad("a colour as six hex digits, rrggbb")),
+                },
                 _ => return Err(FaultSetError::TakesNoValue(fault)),
             };
             set = set.with(parameter);
@@ -857,6 +889,7 @@ mod tests {
             "gamma-applied=srgb",
             "specular-unnormalized-reflection=t",
             "pixel-mapping=upside-down+cubemap-face-flipped=horizontal",
+            "cubemap-ignored=330099",
         ] {
             let set: FaultSet = text.parse().unwrap();
             assert_eq!(set.to_string(), text);

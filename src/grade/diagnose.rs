@@ -324,6 +324,8 @@ pub(super) fn diagnose_class(
             source: Box::new(error),
         };
         let golden_pictures = store.golden();
+        // Where the golden primary rays hit nothing (the background shows).
+        let misses: Vec<bool> = store.golden_film().depth.iter().map(|t| *t == f32::INFINITY).collect();
         let singles: Vec<Candidate> = candidates::singles(&source.case, store.pictures())
             .into_iter()
             .map(|set| {
@@ -371,7 +373,11 @@ pub(super) fn diagnose_class(
         let mut wanted: Vec<FaultSet> = Vec::new();
         for (subject, scores) in subjects.iter().zip(&scored) {
             if let Some(subject) = subject {
-                for set in expansions(&source.case, subject, scores, &singles) {
+                let background = fit_background(subject, &misses, &singles);
+                for set in expansions(&source.case, subject, scores, &singles)
+                    .into_iter()
+                    .chain(background)
+                {
                     if !wanted.contains(&set) && !singles.iter().any(|c| c.set == set) {
                         wanted.push(set);
                     }
@@ -458,6 +464,39 @@ fn student_dir(student: &StudentResult) -> String {
 /// What to render next for an image no single fault explains cleanly: the other members of the
 /// promising families, and pairs: each of the closest promising faults with the faults that
 /// change most of the pixels it leaves failing.
+/// `cubemap-ignored` with the flat colour the student's picture shows where the golden rays
+/// miss, when it shows one there (the course's scenes give a colour beside the cube map, which
+/// the import drops): the median of those pixels, if most of them are within the rubric's
+/// threshold of it.
+fn fit_background(subject: &Subject, misses: &[bool], singles: &[Candidate]) -> Option<FaultSet> {
+    let tried = singles.iter().any(|c| c.set.contains(Fault::CubemapIgnored));
+    if !tried || subject.golden.len() != misses.len() * 3 {
+        return None;
+    }
+    let seen: Vec<[u8; 3]> = subject
+        .student
+        .pixels()
+        .zip(misses)
+        .filter(|(_, miss)| **miss)
+        .map(|(p, _)| p.0)
+        .collect();
+    if seen.len() * 100 < misses.len() {
+        return None;
+    }
+    let median = [0, 1, 2].map(|c| {
+        let mut values: Vec<u8> = seen.iter().map(|p| p[c]).collect();
+        values.sort_unstable();
+        values[values.len() / 2]
+    });
+    let threshold = subject.spec.rule.threshold;
+    let close = seen
+        .iter()
+        .filter(|p| p.iter().zip(median).all(|(v, m)| f64::from(v.abs_diff(m)) <= threshold))
+        .count();
+    (close * 5 >= seen.len() * 4 && median != [0; 3])
+        .then(|| FaultSet::NONE.with(crate::fault::Parameter::Background(median)))
+}
+
 fn expansions(case: &crate::case::Case, subject: &Subject, scores: &[Scored], singles: &[Candidate]) -> Vec<FaultSet> {
     let rule = &subject.spec.rule;
     let mut promising: Vec<&Scored> = scores.iter().filter(|s| s.promising()).collect();

@@ -97,8 +97,11 @@ pub fn case_with_faults(case: &Case, faults: &FaultSet) -> Case {
     if faults.contains(Fault::NoAmbient) {
         case.background.ambient = [0.0; 3];
     }
-    if faults.contains(Fault::CubemapIgnored) {
+    if faults.contains(Fault::CubemapIgnored) && case.background.cube_map.is_some() {
+        // The course's scene gives a colour beside the cube map, which the import drops (a case
+        // has one or the other); the family's member says which colour the program showed.
         case.background.cube_map = None;
+        case.background.color = faults.background();
     }
     if faults.contains(Fault::DirectionalFlipped) {
         for light in &mut case.lights {

@@ -31,7 +31,7 @@ pub fn singles(case: &Case, pictures: &[Picture]) -> Vec<FaultSet> {
 /// family looks promising.
 fn usual_members(fault: Fault) -> usize {
     match fault {
-        Fault::GammaApplied | Fault::SpecularUnnormalizedReflection | Fault::WrongBounces => 2,
+        Fault::GammaApplied | Fault::SpecularUnnormalizedReflection => 2,
         _ => usize::MAX,
     }
 }
