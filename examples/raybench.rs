@@ -26,6 +26,7 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 use goldray::geometry::Ray;
+use goldray::geometry::bvh::PACKET;
 use goldray::geometry::mesh::{Mesh, VertexNormals};
 use goldray::real::{Real, Vec3};
 
@@ -94,6 +95,10 @@ fn run(dir: &Path, mesh_name: &str, rays_name: &str, threads: usize) -> Result<S
     }
     .as_secs_f64();
 
+    // Rays from one point (a pinhole camera's) go in packets of eight consecutive rays, as a
+    // renderer traces camera rays; `RAYBENCH_PACKETS=0` traces them one by one.
+    let from_one_point = rays.iter().all(|ray| ray.origin == rays[0].origin);
+    let packets = from_one_point && std::env::var("RAYBENCH_PACKETS").map_or(true, |v| v != "0");
     let mut t_out = vec![-1.0f32; rays.len()];
     let per_thread = rays.len().div_ceil(threads).next_multiple_of(8).max(8);
     let mut best = f64::INFINITY;
@@ -107,8 +112,17 @@ fn run(dir: &Path, mesh_name: &str, rays_name: &str, threads: usize) -> Result<S
             for (rays, t_out) in rays.chunks(per_thread).zip(t_out.chunks_mut(per_thread)) {
                 let mesh = &mesh;
                 scope.spawn(move || {
-                    for (ray, t) in rays.iter().zip(t_out) {
-                        *t = mesh.intersect(ray, Real::INFINITY).map_or(-1.0, |hit| hit.t);
+                    if packets {
+                        for (rays, t_out) in rays.chunks(PACKET).zip(t_out.chunks_mut(PACKET)) {
+                            let hits = mesh.intersect_packet(rays, Real::INFINITY);
+                            for (t, hit) in t_out.iter_mut().zip(hits) {
+                                *t = hit.map_or(-1.0, |hit| hit.t);
+                            }
+                        }
+                    } else {
+                        for (ray, t) in rays.iter().zip(t_out) {
+                            *t = mesh.intersect(ray, Real::INFINITY).map_or(-1.0, |hit| hit.t);
+                        }
                     }
                 });
             }

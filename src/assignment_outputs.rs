@@ -52,9 +52,11 @@ impl AssignmentOutputs {
             .par_iter()
             .map(|(path, encode)| Ok((*path, encode()?)))
             .collect::<Result<Vec<(&Path, Vec<u8>)>, OutputError>>()?;
-        for (path, bytes) in &files {
-            write_file_atomic(path, bytes)?;
-        }
+        // Each file is synced before it replaces its target; syncing them side by side lets the
+        // file system commit them together rather than one after another.
+        files
+            .par_iter()
+            .try_for_each(|(path, bytes)| write_file_atomic(path, bytes))?;
         Ok(files.into_iter().map(|(path, _)| path.to_path_buf()).collect())
     }
 }

@@ -4,14 +4,16 @@
 use std::time::{Duration, Instant};
 
 use super::aabb::Aabb;
-use super::bvh::{Bvh, LeafCost, Visit, traverse};
+use super::huge_page_vec;
+use super::bvh::{Bvh, LeafCost, LeafVisitor, PACKET, PacketLanes, PacketVisitor, Visit, traverse, traverse_packet};
 use super::triangle::{
-    PackRay, TriangleHit, TrianglePack, face_normal, intersect_pack, lane_hit, normalize, triangle_surface,
+    PackRay, RayLanes, TriangleHit, TrianglePack, face_normal, intersect_pack, intersect_triangle_rays, lane_hit, normalize,
+    triangle_surface,
 };
 use super::{Ray, SurfaceHit};
-use super::real::{Real, Vec3};
+use super::real::{R8, Real, Vec3};
 pub use crate::build_error::MeshError;
-use crate::simd::{Isa, Kernel, dispatch};
+use crate::simd::{Isa, Kernel, Lanes, dispatch};
 use rayon::prelude::*;
 
 /// The vertex normals a mesh is built with.
@@ -123,34 +125,45 @@ impl Mesh {
 
     #[inline(always)]
     fn closest_lanes<I: Isa>(&self, ray: &Ray, t_max: Real) -> Option<MeshHit> {
-        let pack_ray = PackRay::<I>::new(ray);
-        let mut closest: Option<MeshHit> = None;
-        traverse::<I>(self.bvh.nodes(), ray, t_max, |first, count, t_limit| {
-            for pack in &self.packs[first as usize..(first + count) as usize] {
-                let found = intersect_pack::<I>(pack, &pack_ray, *t_limit);
-                let mut lanes = found.lanes;
-                if lanes == 0 {
-                    continue;
-                }
-                let values = found.lanes();
-                while lanes != 0 {
-                    let lane = lanes.trailing_zeros() as usize;
-                    lanes &= lanes - 1;
-                    let (t, triangle) = (values[0][lane], pack.ids()[lane]);
-                    let nearer = match &closest {
-                        Some(best) => t < best.t || (t == best.t && triangle < best.triangle),
-                        None => true,
-                    };
-                    if nearer {
-                        let hit = lane_hit(&values, lane);
-                        *t_limit = t;
-                        closest = Some(MeshHit { t, triangle, barycentrics: [hit.b0, hit.b1, hit.b2] });
-                    }
-                }
+        let mut nearest = NearestTriangle { mesh: self, ray: PackRay::<I>::new(ray), closest: None };
+        traverse::<I>(self.bvh.nodes(), ray, t_max, &mut nearest);
+        nearest.closest
+    }
+
+    /// [`Mesh::intersect`] of up to [`PACKET`] rays at once, each result exactly what
+    /// [`Mesh::intersect`] returns for that ray. Rays that share the signs of their direction
+    /// components and their dominant axis (camera rays through a small tile, say) are traced as
+    /// a packet: each node and each triangle is tested against all of them at once. Others are
+    /// traced one by one.
+    ///
+    /// # Panics
+    /// If there are more than [`PACKET`] rays.
+    pub fn intersect_packet(&self, rays: &[Ray], t_max: Real) -> [Option<MeshHit>; PACKET] {
+        assert!(rays.len() <= PACKET, "a packet holds at most {PACKET} rays");
+        struct Closest<'a>(&'a Mesh, &'a [Ray], Real);
+        impl Kernel for Closest<'_> {
+            type Output = [Option<MeshHit>; PACKET];
+            #[inline(always)]
+            fn run<I: Isa>(self) -> [Option<MeshHit>; PACKET] {
+                self.0.closest_packet::<I>(self.1, self.2)
             }
-            Visit::Continue
-        });
-        closest
+        }
+        dispatch(Closest(self, rays, t_max))
+    }
+
+    #[inline(always)]
+    fn closest_packet<I: Isa>(&self, rays: &[Ray], t_max: Real) -> [Option<MeshHit>; PACKET] {
+        let (Some(slab), Some(triangle_rays)) = (PacketLanes::<I>::new(rays), RayLanes::<I>::new(rays)) else {
+            let mut closest = [None; PACKET];
+            for (hit, ray) in closest.iter_mut().zip(rays) {
+                *hit = self.closest_lanes::<I>(ray, t_max);
+            }
+            return closest;
+        };
+        let mut nearest = NearestTriangles { mesh: self, rays: triangle_rays, closest: [None; PACKET] };
+        let mut t_limit = [t_max; PACKET];
+        traverse_packet::<I>(self.bvh.nodes(), &slab, (1u32 << rays.len()) - 1, &mut t_limit, &mut nearest);
+        nearest.closest
     }
 
     /// Whether anything is hit in `(0, t_max]`; cheaper than [`Mesh::intersect`] because it
@@ -169,18 +182,9 @@ impl Mesh {
 
     #[inline(always)]
     fn any_lanes<I: Isa>(&self, ray: &Ray, t_max: Real) -> bool {
-        let pack_ray = PackRay::<I>::new(ray);
-        let mut found = false;
-        traverse::<I>(self.bvh.nodes(), ray, t_max, |first, count, t_limit| {
-            let packs = &self.packs[first as usize..(first + count) as usize];
-            if packs.iter().any(|pack| intersect_pack::<I>(pack, &pack_ray, *t_limit).lanes != 0) {
-                found = true;
-                Visit::Stop
-            } else {
-                Visit::Continue
-            }
-        });
-        found
+        let mut blocker = AnyTriangle { mesh: self, ray: PackRay::<I>::new(ray), found: false };
+        traverse::<I>(self.bvh.nodes(), ray, t_max, &mut blocker);
+        blocker.found
     }
 
     /// Point, error bound and normals of a hit returned by [`Mesh::intersect`].
@@ -228,6 +232,105 @@ impl Mesh {
     }
 }
 
+/// The leaf test of [`Mesh::intersect`]: each pack of the leaf, keeping the nearest hit (the
+/// smaller triangle index among hits at the same `t`).
+struct NearestTriangle<'a, I: Isa> {
+    mesh: &'a Mesh,
+    ray: PackRay<I>,
+    closest: Option<MeshHit>,
+}
+
+impl<I: Isa> LeafVisitor<I> for NearestTriangle<'_, I> {
+    #[inline(always)]
+    fn leaf(&mut self, first: u32, count: u32, t_limit: &mut Real) -> Visit {
+        for pack in &self.mesh.packs[first as usize..(first + count) as usize] {
+            let found = intersect_pack::<I>(pack, &self.ray, *t_limit);
+            let mut lanes = found.lanes;
+            if lanes == 0 {
+                continue;
+            }
+            let values = found.lanes();
+            while lanes != 0 {
+                let lane = lanes.trailing_zeros() as usize;
+                lanes &= lanes - 1;
+                let (t, triangle) = (values[0][lane], pack.ids()[lane]);
+                let nearer = match &self.closest {
+                    Some(best) => t < best.t || (t == best.t && triangle < best.triangle),
+                    None => true,
+                };
+                if nearer {
+                    let hit = lane_hit(&values, lane);
+                    *t_limit = t;
+                    self.closest = Some(MeshHit { t, triangle, barycentrics: [hit.b0, hit.b1, hit.b2] });
+                }
+            }
+        }
+        Visit::Continue
+    }
+}
+
+/// The leaf test of [`Mesh::occluded`]: stops at the first pack with a hit.
+struct AnyTriangle<'a, I: Isa> {
+    mesh: &'a Mesh,
+    ray: PackRay<I>,
+    found: bool,
+}
+
+impl<I: Isa> LeafVisitor<I> for AnyTriangle<'_, I> {
+    #[inline(always)]
+    fn leaf(&mut self, first: u32, count: u32, t_limit: &mut Real) -> Visit {
+        for pack in &self.mesh.packs[first as usize..(first + count) as usize] {
+            if intersect_pack::<I>(pack, &self.ray, *t_limit).lanes != 0 {
+                self.found = true;
+                return Visit::Stop;
+            }
+        }
+        Visit::Continue
+    }
+}
+
+/// The leaf test of [`Mesh::intersect_packet`]: each triangle of the leaf against the rays
+/// that reached it, keeping each ray's nearest hit as [`NearestTriangle`] does.
+struct NearestTriangles<'a, I: Isa> {
+    mesh: &'a Mesh,
+    rays: RayLanes<I>,
+    closest: [Option<MeshHit>; PACKET],
+}
+
+impl<I: Isa> PacketVisitor<I> for NearestTriangles<'_, I> {
+    #[inline(always)]
+    fn leaf(&mut self, first: u32, count: u32, rays: u32, t_limit: &mut [Real; PACKET]) {
+        for pack in &self.mesh.packs[first as usize..(first + count) as usize] {
+            let mut live = pack.live();
+            while live != 0 {
+                let triangle = live.trailing_zeros() as usize;
+                live &= live - 1;
+                let found = intersect_triangle_rays::<I>(pack, triangle, &self.rays, R8::<I>::load(&t_limit[..]));
+                let mut lanes = found.lanes & rays;
+                if lanes == 0 {
+                    continue;
+                }
+                let values = found.lanes();
+                let id = pack.ids()[triangle];
+                while lanes != 0 {
+                    let lane = lanes.trailing_zeros() as usize;
+                    lanes &= lanes - 1;
+                    let t = values[0][lane];
+                    let nearer = match &self.closest[lane] {
+                        Some(best) => t < best.t || (t == best.t && id < best.triangle),
+                        None => true,
+                    };
+                    if nearer {
+                        let hit = lane_hit(&values, lane);
+                        t_limit[lane] = t;
+                        self.closest[lane] = Some(MeshHit { t, triangle: id, barycentrics: [hit.b0, hit.b1, hit.b2] });
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// Packs each leaf's triangles (`corners` is in leaf order) four at a time, in leaf order, and
 /// points the leaf at its packs.
 fn pack_leaves(bvh: &mut Bvh, corners: &[[Vec3; 3]]) -> Vec<TrianglePack> {
@@ -239,7 +342,8 @@ fn pack_leaves(bvh: &mut Bvh, corners: &[[Vec3; 3]]) -> Vec<TrianglePack> {
         first_pack[first as usize] = packed;
         packed += count.div_ceil(4);
     }
-    let packs = leaves
+    let mut packs = huge_page_vec(packed as usize);
+    let all = leaves
         .par_iter()
         .flat_map_iter(|&(first, count)| {
             (first..first + count).step_by(4).map(move |start| {
@@ -250,8 +354,8 @@ fn pack_leaves(bvh: &mut Bvh, corners: &[[Vec3; 3]]) -> Vec<TrianglePack> {
                 }
                 TrianglePack::new(&lanes[..(end - start) as usize])
             })
-        })
-        .collect();
+        });
+    packs.par_extend(all);
     bvh.remap_leaves(|first, count| (first_pack[first as usize], count.div_ceil(4)));
     packs
 }

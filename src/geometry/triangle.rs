@@ -10,7 +10,7 @@
 use glam::Vec3Swizzles;
 
 use super::{Ray, SurfaceHit};
-use super::real::{R4, Real, Vec3, gamma, narrow4, wide4};
+use super::real::{R4, R8, Real, Vec3, edge8, gamma, narrow4, wide4};
 use crate::simd::{Isa, Lanes, MaskOps};
 
 /// The per-ray part of the test: which axis becomes z, and the shear that makes the ray
@@ -244,11 +244,35 @@ impl<I: Isa> PackHits<I> {
     }
 }
 
-/// Lane `lane` of [`PackHits::lanes`], as [`intersect_triangle`] would report it.
+/// Lane `lane` of [`PackHits::lanes`] or [`RayHits::lanes`], as [`intersect_triangle`] would
+/// report it.
 #[inline(always)]
-pub fn lane_hit(values: &[[Real; 4]; 5], lane: usize) -> TriangleHit {
+pub fn lane_hit<const N: usize>(values: &[[Real; N]; 5], lane: usize) -> TriangleHit {
     let inv_det = values[4][lane];
     TriangleHit { t: values[0][lane], b0: values[1][lane] * inv_det, b1: values[2][lane] * inv_det, b2: values[3][lane] * inv_det }
+}
+
+/// Vertex `v` of each lane of `pack`, relative to the origin, permuted and sheared.
+#[inline(always)]
+fn pack_vertex<I: Isa>(pack: &TrianglePack, ray: &PackRay<I>, v: usize) -> [R4<I>; 3] {
+    let [kx, ky, kz] = ray.axes;
+    let corner = &pack.corners[v];
+    let qx = R4::<I>::load(&corner[kx]) - ray.origin[0];
+    let qy = R4::<I>::load(&corner[ky]) - ray.origin[1];
+    let qz = R4::<I>::load(&corner[kz]) - ray.origin[2];
+    [qx + ray.shear[0] * qz, qy + ray.shear[1] * qz, qz]
+}
+
+/// [`edge_function`] on four lanes.
+#[inline(always)]
+fn pack_edge<I: Isa>(a: &[R4<I>; 3], b: &[R4<I>; 3]) -> R4<I> {
+    narrow4::<I>(wide4::<I>(a[0]) * wide4::<I>(b[1]) - wide4::<I>(a[1]) * wide4::<I>(b[0]))
+}
+
+/// `max(|a|, max(|b|, |c|))` per lane (`Vec3::abs().max_element()`).
+#[inline(always)]
+fn max_abs3<L: Lanes>(a: L, b: L, c: L) -> L {
+    a.abs().max(b.abs().max(c.abs()))
 }
 
 /// [`intersect_triangle`] on the four lanes of `pack`, with the same operations in the same
@@ -257,19 +281,8 @@ pub fn lane_hit(values: &[[Real; 4]; 5], lane: usize) -> TriangleHit {
 /// A kernel: compile it only inside one (see `crate::simd`).
 #[inline(always)]
 pub fn intersect_pack<I: Isa>(pack: &TrianglePack, ray: &PackRay<I>, t_max: Real) -> PackHits<I> {
-    let [kx, ky, kz] = ray.axes;
-    let vertex = |v: usize| {
-        let corner = &pack.corners[v];
-        let qx = R4::<I>::load(&corner[kx]) - ray.origin[0];
-        let qy = R4::<I>::load(&corner[ky]) - ray.origin[1];
-        let qz = R4::<I>::load(&corner[kz]) - ray.origin[2];
-        [qx + ray.shear[0] * qz, qy + ray.shear[1] * qz, qz]
-    };
-    let (p0, p1, p2) = (vertex(0), vertex(1), vertex(2));
-    let edge = |a: &[R4<I>; 3], b: &[R4<I>; 3]| {
-        narrow4::<I>(wide4::<I>(a[0]) * wide4::<I>(b[1]) - wide4::<I>(a[1]) * wide4::<I>(b[0]))
-    };
-    let (e0, e1, e2) = (edge(&p1, &p2), edge(&p2, &p0), edge(&p0, &p1));
+    let (p0, p1, p2) = (pack_vertex(pack, ray, 0), pack_vertex(pack, ray, 1), pack_vertex(pack, ray, 2));
+    let (e0, e1, e2) = (pack_edge::<I>(&p1, &p2), pack_edge::<I>(&p2, &p0), pack_edge::<I>(&p0, &p1));
     let zero = R4::<I>::splat(0.0);
     let negative = e0.lt(zero).or(e1.lt(zero)).or(e2.lt(zero));
     let positive = e0.gt(zero).or(e1.gt(zero)).or(e2.gt(zero));
@@ -287,7 +300,7 @@ pub fn intersect_pack<I: Isa>(pack: &TrianglePack, ray: &PackRay<I>, t_max: Real
         return PackHits { lanes: 0, t, edges: [e0, e1, e2], inv_det };
     }
 
-    let max3 = |a: R4<I>, b: R4<I>, c: R4<I>| a.abs().max(b.abs().max(c.abs()));
+    let max3 = max_abs3::<R4<I>>;
     let max_zt = max3(z0, z1, z2);
     let max_unscaled_zt = max3(p0[2], p1[2], p2[2]);
     let max_xt = max3(p0[0], p1[0], p2[0]);
@@ -302,6 +315,141 @@ pub fn intersect_pack<I: Isa>(pack: &TrianglePack, ray: &PackRay<I>, t_max: Real
 
     let hit = candidates.and_not(t.le(delta_t));
     PackHits { lanes: hit.bits() & pack.live, t, edges: [e0, e1, e2], inv_det }
+}
+
+/// Up to eight rays whose triangle tests share a permutation (the same axis becomes z), one
+/// per lane, for [`intersect_triangle_rays`].
+pub struct RayLanes<I: Isa> {
+    axes: [usize; 3],
+    /// Each ray's origin, permuted.
+    origin: [R8<I>; 3],
+    shear: [R8<I>; 3],
+}
+
+impl<I: Isa> RayLanes<I> {
+    /// `None` when the rays do not all turn the same axis into z (or there are more than
+    /// eight); lanes past the last ray repeat it.
+    #[inline(always)]
+    pub fn new(rays: &[Ray]) -> Option<Self> {
+        if rays.is_empty() || rays.len() > 8 {
+            return None;
+        }
+        let first = TriangleRay::new(&rays[0]);
+        let mut lanes = [[0.0; 8]; 6];
+        for lane in 0..8 {
+            let ray = &rays[lane.min(rays.len() - 1)];
+            let triangle_ray = TriangleRay::new(ray);
+            if triangle_ray.axis_z != first.axis_z {
+                return None;
+            }
+            let origin = permute(ray.origin, first.axis_z);
+            let shear = triangle_ray.shear;
+            for (values, value) in lanes.iter_mut().zip([origin.x, origin.y, origin.z, shear.x, shear.y, shear.z]) {
+                values[lane] = value;
+            }
+        }
+        let l = &lanes;
+        Some(RayLanes {
+            axes: match first.axis_z {
+                0 => [1, 2, 0],
+                1 => [2, 0, 1],
+                _ => [0, 1, 2],
+            },
+            origin: [R8::<I>::load(&l[0]), R8::<I>::load(&l[1]), R8::<I>::load(&l[2])],
+            shear: [R8::<I>::load(&l[3]), R8::<I>::load(&l[4]), R8::<I>::load(&l[5])],
+        })
+    }
+}
+
+/// What [`intersect_triangle_rays`] found: the rays (lanes) that hit, and what each hit is made
+/// of, as in [`PackHits`].
+pub struct RayHits<I: Isa> {
+    pub lanes: u32,
+    t: R8<I>,
+    edges: [R8<I>; 3],
+    inv_det: R8<I>,
+}
+
+impl<I: Isa> RayHits<I> {
+    /// `t`, the three edge functions and the inverse determinant of each lane.
+    #[inline(always)]
+    pub fn lanes(&self) -> [[Real; 8]; 5] {
+        let mut values = [[0.0; 8]; 5];
+        self.t.store(&mut values[0]);
+        self.edges[0].store(&mut values[1]);
+        self.edges[1].store(&mut values[2]);
+        self.edges[2].store(&mut values[3]);
+        self.inv_det.store(&mut values[4]);
+        values
+    }
+}
+
+/// Vertex `v` of triangle `triangle` of `pack`, relative to each ray's origin, permuted and
+/// sheared.
+#[inline(always)]
+fn rays_vertex<I: Isa>(pack: &TrianglePack, triangle: usize, rays: &RayLanes<I>, v: usize) -> [R8<I>; 3] {
+    let [kx, ky, kz] = rays.axes;
+    let corner = &pack.corners[v];
+    let qx = R8::<I>::splat(corner[kx][triangle]) - rays.origin[0];
+    let qy = R8::<I>::splat(corner[ky][triangle]) - rays.origin[1];
+    let qz = R8::<I>::splat(corner[kz][triangle]) - rays.origin[2];
+    [qx + rays.shear[0] * qz, qy + rays.shear[1] * qz, qz]
+}
+
+/// [`intersect_triangle`] of triangle `triangle` of `pack` against each ray of `rays`, the rays
+/// in lanes: the same operations in the same order as the one-ray test (and as
+/// [`intersect_pack`]), so each lane's hit is bit for bit that ray's. `t_max` is per ray.
+///
+/// A kernel: compile it only inside one (see `crate::simd`).
+#[inline(always)]
+pub fn intersect_triangle_rays<I: Isa>(
+    pack: &TrianglePack,
+    triangle: usize,
+    rays: &RayLanes<I>,
+    t_max: R8<I>,
+) -> RayHits<I> {
+    let splat = R8::<I>::splat;
+    let (p0, p1, p2) = (rays_vertex(pack, triangle, rays, 0), rays_vertex(pack, triangle, rays, 1), rays_vertex(pack, triangle, rays, 2));
+    let (e0, e1, e2) = (
+        edge8::<I>(p1[0], p1[1], p2[0], p2[1]),
+        edge8::<I>(p2[0], p2[1], p0[0], p0[1]),
+        edge8::<I>(p0[0], p0[1], p1[0], p1[1]),
+    );
+    let zero = splat(0.0);
+    let negative = e0.lt(zero).or(e1.lt(zero)).or(e2.lt(zero));
+    let positive = e0.gt(zero).or(e1.gt(zero)).or(e2.gt(zero));
+    let det = e0 + e1 + e2;
+    let shear_z = rays.shear[2];
+    let (z0, z1, z2) = (p0[2] * shear_z, p1[2] * shear_z, p2[2] * shear_z);
+    let t_scaled = e0 * z0 + e1 * z1 + e2 * z2;
+    let in_front = det.gt(zero).and(t_scaled.gt(zero)).or(det.lt(zero).and(t_scaled.lt(zero)));
+    let inv_det = splat(1.0) / det;
+    let t = t_scaled * inv_det;
+    let candidates = in_front.and_not(negative.and(positive)).and(t.le(t_max));
+    if candidates.bits() == 0 {
+        return RayHits { lanes: 0, t, edges: [e0, e1, e2], inv_det };
+    }
+    let max3 = max_abs3::<R8<I>>;
+    let max_zt = max3(z0, z1, z2);
+    let max_unscaled_zt = max3(p0[2], p1[2], p2[2]);
+    let max_xt = max3(p0[0], p1[0], p2[0]);
+    let max_yt = max3(p0[1], p1[1], p2[1]);
+    let delta_z = splat(gamma(3)) * max_zt;
+    let delta_x = splat(gamma(5)) * (max_xt + max_unscaled_zt);
+    let delta_y = splat(gamma(5)) * (max_yt + max_unscaled_zt);
+    let delta_e = splat(2.0) * (splat(gamma(2)) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
+    let max_e = max3(e0, e1, e2);
+    let delta_t =
+        splat(3.0) * (splat(gamma(3)) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
+    let hit = candidates.and_not(t.le(delta_t));
+    RayHits { lanes: hit.bits(), t, edges: [e0, e1, e2], inv_det }
+}
+
+impl TrianglePack {
+    /// Bit per lane holding a triangle that can be hit.
+    pub fn live(&self) -> u32 {
+        self.live
+    }
 }
 
 /// Describes the hit surface for shading and for spawning secondary rays.

@@ -15,3 +15,9 @@ pub fn wide4<I: crate::simd::Isa>(x: R4<I>) -> I::F64x4 {
 pub fn narrow4<I: crate::simd::Isa>(x: I::F64x4) -> R4<I> {
     x
 }
+
+/// The triangle test's edge function `a.x·b.y − a.y·b.x` on eight lanes (already `f64`).
+#[inline(always)]
+pub fn edge8<I: crate::simd::Isa>(ax: R8<I>, ay: R8<I>, bx: R8<I>, by: R8<I>) -> R8<I> {
+    ax * by - ay * bx
+}

@@ -16,3 +16,16 @@ pub fn wide4<I: crate::simd::Isa>(x: R4<I>) -> I::F64x4 {
 pub fn narrow4<I: crate::simd::Isa>(x: I::F64x4) -> R4<I> {
     I::narrow(x)
 }
+
+/// The triangle test's edge function `a.x·b.y − a.y·b.x` on eight lanes, in `f64` (exact
+/// products) rounded back, as `geometry::triangle` computes it lane by lane.
+#[inline(always)]
+pub fn edge8<I: crate::simd::Isa>(ax: R8<I>, ay: R8<I>, bx: R8<I>, by: R8<I>) -> R8<I> {
+    let [(ax0, ax1), (ay0, ay1), (bx0, bx1), (by0, by1)] = [I::split(ax), I::split(ay), I::split(bx), I::split(by)];
+    I::join(edge4::<I>(ax0, ay0, bx0, by0), edge4::<I>(ax1, ay1, bx1, by1))
+}
+
+#[inline(always)]
+fn edge4<I: crate::simd::Isa>(ax: I::F32x4, ay: I::F32x4, bx: I::F32x4, by: I::F32x4) -> I::F32x4 {
+    I::narrow(I::widen(ax) * I::widen(by) - I::widen(ay) * I::widen(bx))
+}

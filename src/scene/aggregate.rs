@@ -2,7 +2,7 @@
 //! and everything else under a BVH.
 
 use super::geometry::aabb::{Aabb, SlabRay};
-use super::geometry::bvh::{Bvh, LeafCost, Visit, traverse};
+use super::geometry::bvh::{Bvh, LeafCost, Visit, VisitFn, traverse};
 use super::geometry::plane::{PLANE_LANES, Plane, PlanePack, intersect_planes};
 use super::geometry::sphere::{SPHERE_LANES, SphereRay, SpherePack, intersect_spheres};
 use super::geometry::{Ray, SurfaceHit};
@@ -189,7 +189,7 @@ impl Aggregate {
                 }
             }
             Rest::Tree { bvh, objects } => {
-                traverse::<I>(bvh.nodes(), ray, closest.t, |first, count, t_limit| {
+                traverse::<I>(bvh.nodes(), ray, closest.t, &mut VisitFn(|first: u32, count: u32, t_limit: &mut Real| {
                     for &index in &objects[first as usize..(first + count) as usize] {
                         if let Some(hit) = self.objects[index as usize].intersect(ray, *t_limit) {
                             closest.offer(hit.t(), index, Found::Object(index, hit));
@@ -197,7 +197,7 @@ impl Aggregate {
                         }
                     }
                     Visit::Continue
-                });
+                }));
             }
         }
         closest.found
@@ -235,7 +235,7 @@ impl Aggregate {
             }
             Rest::Tree { bvh, objects } => {
                 let mut blocked = false;
-                traverse::<I>(bvh.nodes(), ray, t_max, |first, count, t_limit| {
+                traverse::<I>(bvh.nodes(), ray, t_max, &mut VisitFn(|first: u32, count: u32, t_limit: &mut Real| {
                     let leaf = &objects[first as usize..(first + count) as usize];
                     if leaf.iter().any(|&index| self.objects[index as usize].occluded(ray, *t_limit)) {
                         blocked = true;
@@ -243,7 +243,7 @@ impl Aggregate {
                     } else {
                         Visit::Continue
                     }
-                });
+                }));
                 blocked
             }
         }

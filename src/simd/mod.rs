@@ -164,6 +164,13 @@ pub trait Isa: Copy + 'static {
     fn widen(x: Self::F32x4) -> Self::F64x4;
     /// Each lane rounded to the nearest `f32`.
     fn narrow(x: Self::F64x4) -> Self::F32x4;
+    /// Lanes 0–3 and 4–7.
+    fn split(x: Self::F32x8) -> (Self::F32x4, Self::F32x4);
+    /// The inverse of [`Isa::split`].
+    fn join(low: Self::F32x4, high: Self::F32x4) -> Self::F32x8;
+    /// Asks for the cache line holding `address` to be loaded, without waiting for it (a hint
+    /// that changes no result; nothing on the portable path).
+    fn prefetch<T>(address: *const T);
 }
 
 /// `N` floating-point lanes with the same operation applied to each.

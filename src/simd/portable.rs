@@ -23,6 +23,21 @@ impl Isa for Portable {
     fn narrow(x: Array<f64, 4>) -> Array<f32, 4> {
         Array(x.0.map(|v| v as f32))
     }
+
+    #[inline(always)]
+    fn split(x: Array<f32, 8>) -> (Array<f32, 4>, Array<f32, 4>) {
+        let [a, b, c, d, e, f, g, h] = x.0;
+        (Array([a, b, c, d]), Array([e, f, g, h]))
+    }
+
+    #[inline(always)]
+    fn join(low: Array<f32, 4>, high: Array<f32, 4>) -> Array<f32, 8> {
+        let ([a, b, c, d], [e, f, g, h]) = (low.0, high.0);
+        Array([a, b, c, d, e, f, g, h])
+    }
+
+    #[inline(always)]
+    fn prefetch<T>(_: *const T) {}
 }
 
 /// `N` lanes of `T`.

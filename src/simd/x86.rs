@@ -68,6 +68,27 @@ macro_rules! isa {
             fn narrow(x: F64x4) -> F32x4 {
                 unsafe { F32x4(_mm256_cvtpd_ps(x.0)) }
             }
+
+            #[inline(always)]
+            fn split(x: F32x8) -> (F32x4, F32x4) {
+                unsafe {
+                    (
+                        F32x4(_mm256_castps256_ps128(x.0)),
+                        F32x4(_mm256_extractf128_ps::<1>(x.0)),
+                    )
+                }
+            }
+
+            #[inline(always)]
+            fn join(low: F32x4, high: F32x4) -> F32x8 {
+                unsafe { F32x8(_mm256_set_m128(high.0, low.0)) }
+            }
+
+            #[inline(always)]
+            fn prefetch<T>(address: *const T) {
+                // SAFETY: a prefetch never faults, whatever the address.
+                unsafe { _mm_prefetch::<_MM_HINT_T0>(address.cast()) }
+            }
         }
     };
 }

@@ -9,11 +9,12 @@
 
 use super::build::BinaryNode;
 use super::{BvhNode, WIDTH};
+use super::super::huge_page_vec;
 use super::super::real::Real;
 
 /// The wide nodes in depth-first order (a node's first interior child follows it), root first.
 pub(super) fn collapse(binary: &[BinaryNode]) -> Vec<BvhNode> {
-    let mut nodes = Vec::with_capacity(binary.len() / 2 + 1);
+    let mut nodes = huge_page_vec(binary.len() / 2 + 1);
     if !binary.is_empty() {
         emit(binary, 0, &mut nodes);
     }
