@@ -203,14 +203,11 @@ pub fn summary(body: &mut String, student: &StudentResult) {
             credit(&images),
         );
         let caption = if diagnosis.id.contains('+') {
-            format!(
-                "the mistakes' render ({})",
-                escape(diagnosis.faults.as_deref().unwrap_or(""))
-            )
+            "with both mistakes"
         } else {
-            "the mistake's render".to_owned()
+            "the mistake's render"
         };
-        pictures(body, first, diagnosis, &caption);
+        pictures(body, first, diagnosis, caption);
         body.push_str("</section>\n");
     }
     body.push_str("</div>\n");
