@@ -249,3 +249,36 @@ impl Aggregate {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use super::super::geometry::sphere::Sphere;
+    use super::super::real::Vec3;
+
+    fn sphere(material: u32) -> Object {
+        Object { shape: Shape::Sphere(Sphere { center: Vec3::ZERO, radius: 1.0 }), transform: None, material }
+    }
+
+    fn first_material(aggregate: &Aggregate) -> u32 {
+        let ray = Ray::new(Vec3::new(0.1, 0.2, 5.0), Vec3::new(0.0, 0.0, -1.0));
+        aggregate.intersect(&ray).expect("hit").material
+    }
+
+    /// Coinciding surfaces are hit at exactly the same `t`: the object listed first wins, whether
+    /// the spheres are tested side by side or in a tree, and objects win over planes.
+    #[test]
+    fn of_surfaces_hit_at_the_same_t_the_first_listed_wins() {
+        for count in [2, 8, 9, 20] {
+            let aggregate = Aggregate::new((0..count).map(sphere).collect(), Vec::new());
+            assert_eq!(aggregate.bvh().is_some(), count as usize > SPHERE_PACK_LIMIT, "{count} spheres");
+            assert_eq!(first_material(&aggregate), 0, "{count} spheres");
+        }
+        let on_the_sphere = Plane::new(Vec3::Z, 1.0);
+        let aggregate = Aggregate::new(vec![sphere(3)], vec![(on_the_sphere, 7), (on_the_sphere, 8)]);
+        let ray = Ray::new(Vec3::new(0.0, 0.0, 5.0), Vec3::new(0.0, 0.0, -1.0));
+        assert_eq!(aggregate.intersect(&ray).expect("hit").material, 3);
+        let planes_only = Aggregate::new(Vec::new(), vec![(on_the_sphere, 7), (on_the_sphere, 8)]);
+        assert_eq!(planes_only.intersect(&ray).expect("hit").material, 7);
+    }
+}
