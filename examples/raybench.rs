@@ -116,12 +116,12 @@ fn run(dir: &Path, mesh_name: &str, rays_name: &str, threads: usize) -> Result<S
                         for (rays, t_out) in rays.chunks(PACKET).zip(t_out.chunks_mut(PACKET)) {
                             let hits = mesh.intersect_packet(rays, Real::INFINITY);
                             for (t, hit) in t_out.iter_mut().zip(hits) {
-                                *t = hit.map_or(-1.0, |hit| hit.t as f32);
+                                *t = hit.map_or(-1.0, |hit| hit.t);
                             }
                         }
                     } else {
                         for (ray, t) in rays.iter().zip(t_out) {
-                            *t = mesh.intersect(ray, Real::INFINITY).map_or(-1.0, |hit| hit.t as f32);
+                            *t = mesh.intersect(ray, Real::INFINITY).map_or(-1.0, |hit| hit.t);
                         }
                     }
                 });

@@ -15,7 +15,9 @@ export RUSTC_BOOTSTRAP=1
 cargo fuzz build -O
 log=$(mktemp)
 for target in case_toml assignment_scene obj png_decode; do
-    if ! cargo fuzz run -O "$target" "corpus/$target" -- \
+    dict=()
+    if [ -f "$target.dict" ]; then dict=(-dict="$target.dict"); fi
+    if ! cargo fuzz run -O "$target" "corpus/$target" -- "${dict[@]}" \
         -max_total_time="$seconds" -timeout=10 -print_final_stats=1 >"$log" 2>&1; then
         tail -n 40 "$log" >&2
         echo "fuzz target $target failed; reproducer in fuzz/artifacts/$target/" >&2

@@ -11,6 +11,7 @@ pub mod build_error;
 pub mod case;
 pub mod compare;
 pub mod error;
+pub mod fault;
 pub mod film;
 pub mod grade;
 pub mod image_size;

@@ -43,13 +43,26 @@ named_enum! {
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub enum Spawn {
     /// Off the surface by exactly the hit point's rounding-error bound, which is right at every
-    /// scale (pbrt-v4). What every command renders with; a case file cannot choose otherwise.
+    /// scale (pbrt-v4). What every native-profile case renders with; a case file cannot choose
+    /// otherwise.
     #[default]
     ErrorBounds,
     /// On the surface, ignoring whatever lies closer than this distance: the classic assignment's
     /// `tmin = 1e-4`. Offered to library users to show (as tests/scale_invariance.rs does) or
     /// reproduce what a fixed epsilon does to a scene.
     FixedEpsilon(f64),
+    /// The course's reference renderer, which `profile = "mit6837"` renders with (read from its
+    /// binary): every secondary ray starts 0.01 along its direction as computed, unnormalised
+    /// (`p + 0.01·R`); a reflected direction is `d − 2(d·N)N` of the unnormalised incoming `d`,
+    /// which is also the view direction of the next hit's highlight; and only a material whose
+    /// specular colour is longer than 0.1 reflects at all.
+    Course,
+}
+
+impl Spawn {
+    /// The course's reflected-ray offset, and the length a specular colour must exceed there.
+    pub const COURSE_OFFSET: f64 = 0.01;
+    pub const COURSE_MIRROR_THRESHOLD: f64 = 0.1;
 }
 
 /// What a render traces: the part a case's `[render]` table and the renderer's options share,

@@ -5,13 +5,18 @@ use std::time::{Duration, Instant};
 
 use crate::assignment_outputs::AssignmentOutputs;
 use crate::build_error::BuildError;
-use crate::case::{self, AssignmentOptions, Case, LoadOptions, case_to_toml, load_assignment_scene};
+use crate::case::{
+    self, AssignmentOptions, Case, LoadOptions, case_to_toml, case_to_toml_anywhere, load_assignment_scene,
+};
 use crate::error::Error;
 use crate::film::{Film, OutputOptions, write_outputs};
-use crate::options::{RenderOptions, Spawn};
+use crate::options::{Profile, RenderOptions, Spawn};
 use crate::progress::{Progress, Silent};
 use crate::stats::{BuildStats, Phases, RayCounts, RenderStats};
 use crate::with_precision;
+
+mod faults;
+pub use faults::{FaultRenderer, case_with_faults, fault_applies, orthonormal_up, render_case_with_faults};
 
 /// What a command wrote, and the statistics of the render behind it.
 #[derive(Debug)]
@@ -78,7 +83,10 @@ pub struct MeasuredRender {
 pub fn render_options(case: &Case) -> RenderOptions {
     RenderOptions {
         trace: case.render.trace,
-        spawn: Spawn::ErrorBounds,
+        spawn: match case.render.profile {
+            Profile::Native => Spawn::ErrorBounds,
+            Profile::Mit6837 => Spawn::Course,
+        },
         aovs: true,
     }
 }
@@ -159,8 +167,12 @@ fn measured_run(
 }
 
 /// `goldray import`: the TOML case equivalent to a course scene file, with asset paths
-/// relative to where the TOML will live.
-pub fn import_assignment(scene: &Path, options: &AssignmentOptions, toml_path: &Path) -> Result<String, Error> {
+/// relative to where the TOML will live, or absolute when that is unknown (`None`: standard
+/// output).
+pub fn import_assignment(scene: &Path, options: &AssignmentOptions, toml_path: Option<&Path>) -> Result<String, Error> {
     let case = load_assignment_scene(scene, options)?;
-    Ok(case_to_toml(&case, toml_path))
+    Ok(match toml_path {
+        Some(path) => case_to_toml(&case, path),
+        None => case_to_toml_anywhere(&case),
+    })
 }

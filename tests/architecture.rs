@@ -15,6 +15,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("located_toml", 1),
     ("build_error", 2),
     ("options", 2),
+    ("fault", 2),
     ("stats", 2),
     ("precision", 3),
     ("real", 3),

@@ -9,6 +9,13 @@ mod errors;
 mod export;
 #[path = "assignment_scenes/fuzz.rs"]
 mod fuzz;
+/// The differential test's scene generator, to check here that goldray takes what it writes.
+/// Only the driver reads a scene's image size, depth range and bounces.
+#[path = "../examples/course_diff/generate.rs"]
+#[allow(dead_code)]
+mod generate;
+#[path = "assignment_scenes/reference.rs"]
+mod reference;
 #[path = "assignment_scenes/syntax.rs"]
 mod syntax;
 
@@ -274,26 +281,35 @@ fn scene07_has_a_point_light_with_falloff_and_four_coloured_parts() {
     );
 }
 
+/// One material and a group of one sphere that uses it.
+const ONE_SPHERE: &str = "Materials { numMaterials 1 Material { } }\nGroup { numObjects 1 MaterialIndex 0 Sphere { center 0 0 0 radius 1 } }\n";
+
+/// The course tests `numLights` of the latest Lights block, not the lights it holds.
 #[test]
 fn without_lights_the_ambient_light_is_white_whatever_the_file_says() {
     let background = "Background { color 0 0 0 ambientLight 0.1 0.2 0.3 }\n";
-    let group = format!("Group {{ numObjects 1 {} }}\n", sphere("0 0 0"));
-    let no_block = parse_ok(&with_camera(&format!("{background}{group}")));
+    let no_block = parse_ok(&with_camera(&format!("{background}{ONE_SPHERE}")));
     assert_eq!(no_block.background.ambient, [1.0; 3]);
     assert!(no_block.lights.is_empty());
-    let zero = parse_ok(&with_camera(&format!("Lights {{ numLights 0 }}\n{background}{group}")));
+    let zero = parse_ok(&with_camera(&format!(
+        "Lights {{ numLights 0 }}\n{background}{ONE_SPHERE}"
+    )));
     assert_eq!(zero.background.ambient, [1.0; 3]);
-    let lit =
-        format!("Lights {{ numLights 1 DirectionalLight {{ direction 0 0 -1 color 1 1 1 }} }}\n{background}{group}");
-    assert_eq!(parse_ok(&with_camera(&lit)).background.ambient, [0.1, 0.2, 0.3]);
+    let light = "Lights { numLights 1 DirectionalLight { direction 0 0 -1 color 1 1 1 } }\n";
+    let lit = parse_ok(&with_camera(&format!("{light}{background}{ONE_SPHERE}")));
+    assert_eq!(lit.background.ambient, [0.1, 0.2, 0.3]);
+    let zero_after = parse_ok(&with_camera(&format!(
+        "{light}Lights {{ numLights 0 }}\n{background}{ONE_SPHERE}"
+    )));
+    assert_eq!(zero_after.background.ambient, [1.0; 3], "the latest count is 0");
+    assert_eq!(zero_after.lights.len(), 1, "and the earlier light still shines");
 }
 
 #[test]
 fn missing_optional_blocks_take_the_course_defaults() {
-    let case = parse_ok(&with_camera(&format!("Group {{ numObjects 1 {} }}", sphere("0 0 0"))));
+    let case = parse_ok(&with_camera(ONE_SPHERE));
     assert_eq!(case.background.color, [0.5; 3]);
-    assert!(case.materials.is_empty());
-    assert_eq!(case.objects[0].material, None, "no MaterialIndex yet");
+    assert_eq!(case.materials[0].diffuse, [1.0; 3]);
     let case = parse_ok(&with_camera(
         "Materials { numMaterials 1 PhongMaterial { bump tex/none.png } }\nGroup { numObjects 0 }",
     ));

@@ -3,22 +3,10 @@
 
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn goldray(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_goldray"))
-        .args(args)
-        .output()
-        .expect("the goldray binary runs")
-}
+mod util;
 
-fn case(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("cases").join(name)
-}
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
-}
+use util::{goldray, shipped as case, stderr};
 
 fn files_in(dir: &Path) -> Vec<String> {
     let mut names: Vec<String> = match fs::read_dir(dir) {
@@ -207,6 +195,9 @@ fn a_bad_command_line_exits_2_on_every_command() {
     );
     let unknown = goldray(&["render", "x.toml", "--no-such-flag"]);
     assert_eq!(unknown.status.code(), Some(2));
+    let bad_size = goldray(&["tradeoff", case("jitter.toml").to_str().unwrap(), "--size", "0", "10"]);
+    assert_eq!(bad_size.status.code(), Some(2), "{}", stderr(&bad_size));
+    assert!(stderr(&bad_size).contains("size 0 10: each side must be between 1 and 16384"));
     let bad_pixel = goldray(&["diff", "a.png", "b.png", "--pixel", "nan"]);
     assert_eq!(bad_pixel.status.code(), Some(2));
     assert!(!Path::new("x.png").exists());
@@ -356,4 +347,29 @@ fn help_speaks_each_command_s_own_syntax() {
         text.contains("--threads") && !text.contains("--jobs"),
         "--jobs is a hidden alias: {text}"
     );
+}
+
+/// `goldray import scene.txt > anywhere/case.toml` must give a case that loads where it is saved,
+/// so asset paths written to standard output are absolute, and the header says so.
+#[test]
+fn import_to_standard_output_works_wherever_the_output_is_saved() {
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/mit6837/scene05_bunny_200.txt");
+    let result = goldray(&["import", scene.to_str().unwrap(), "-size", "40", "40"]);
+    assert!(result.status.success(), "{}", stderr(&result));
+    let text = String::from_utf8(result.stdout).unwrap();
+    assert!(text.contains("# Paths are absolute"), "{text}");
+    let dir = tempfile::tempdir().unwrap();
+    let saved = dir.path().join("sub/deeper/case.toml");
+    fs::create_dir_all(saved.parent().unwrap()).unwrap();
+    fs::write(&saved, &text).unwrap();
+    let out = dir.path().join("out");
+    let render = goldray(&[
+        "render",
+        saved.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--quiet",
+    ]);
+    assert!(render.status.success(), "{}", stderr(&render));
+    assert!(out.join("case.png").is_file());
 }

@@ -5,10 +5,11 @@
 
 #[path = "compare/diff_cli.rs"]
 mod diff_cli;
+mod util;
 
 use std::path::Path;
 
-use goldray::case::{Case, LoadOptions, load, parse};
+use goldray::case::{Case, LoadOptions, parse};
 use goldray::compare::{
     Comparison, EXR_DEFAULTS, FAILING, Image, Limit, NON_FINITE, Tolerance, Verdict, compare, diff_heatmap,
 };
@@ -16,10 +17,7 @@ use goldray::film::Film;
 use goldray::pipeline::render_case;
 
 fn case(name: &str) -> Case {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("cases")
-        .join(format!("{name}.toml"));
-    load(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"))
+    util::load_shipped(name)
 }
 
 fn render(case: &Case) -> Film {

@@ -2,6 +2,8 @@
 //! against the imported TOML case. Reads the course's scenes from `cases/mit6837/` and its
 //! reference images from `tests/data/mit6837/`.
 
+mod util;
+
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -23,16 +25,10 @@ fn reference_path(file: &str) -> PathBuf {
         .join(file)
 }
 
+/// Runs goldray and insists that it succeeded.
 fn goldray(args: &[&str]) -> Output {
-    let output = Command::new(env!("CARGO_BIN_EXE_goldray"))
-        .args(args)
-        .output()
-        .expect("the goldray binary runs");
-    assert!(
-        output.status.success(),
-        "goldray {args:?}: {}",
-        String::from_utf8_lossy(&output.stderr)
-    );
+    let output = util::goldray(args);
+    assert!(output.status.success(), "goldray {args:?}: {}", util::stderr(&output));
     output
 }
 
@@ -191,7 +187,7 @@ fn drop_in_command_and_imported_case_give_identical_files() {
 #[test]
 fn the_course_command_line_rejects_what_the_course_binary_would() {
     let input = scene_path("scene01_plane.txt");
-    let run = |args: &[&str]| Command::new(env!("CARGO_BIN_EXE_goldray")).args(args).output().unwrap();
+    let run = util::goldray;
     let unknown = run(&[
         "mit6837",
         "-input",

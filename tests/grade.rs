@@ -10,6 +10,8 @@ mod chromium;
 mod class;
 #[path = "grade/cli.rs"]
 mod cli;
+#[path = "grade/integrity.rs"]
+mod integrity;
 #[path = "grade/rubrics.rs"]
 mod rubrics;
 
@@ -186,19 +188,41 @@ fn grades_csv_parses_back_to_the_report() {
     let text = fs::read_to_string(out.join("grades.csv")).unwrap();
     let rows = parse_csv(&text);
     let header: Vec<&str> = rows[0].iter().map(String::as_str).collect();
-    assert_eq!(header, ["student", "color.png", "normals.png", "depth.png", "total"]);
+    assert_eq!(
+        header,
+        [
+            "student",
+            "color.png",
+            "normals.png",
+            "depth.png",
+            "total",
+            "flags",
+            "diagnoses"
+        ]
+    );
     assert_eq!(rows.len(), report.students.len() + 1, "one row per student");
     let by_name: BTreeMap<&str, &Vec<String>> = rows[1..].iter().map(|r| (r[0].as_str(), r)).collect();
     for s in &report.students {
         let row = by_name
             .get(s.name.as_str())
             .unwrap_or_else(|| panic!("{} has no row:\n{text}", s.name));
-        let numbers: Vec<f64> = row[1..].iter().map(|v| v.parse().unwrap()).collect();
+        let numbers: Vec<f64> = row[1..row.len() - 2].iter().map(|v| v.parse().unwrap()).collect();
+        assert_eq!(row[row.len() - 2], goldray::grade::flags(s).join("; "), "{}", s.name);
+        assert_eq!(
+            row[row.len() - 1],
+            goldray::grade::diagnoses_of(s).join("; "),
+            "{}",
+            s.name
+        );
         let points: Vec<f64> = s.images.iter().map(|i| i.points).collect();
         assert_eq!(numbers[..3], points[..], "{}", s.name);
         assert_eq!(numbers[3], s.total);
         assert!(numbers[..3].iter().zip(POINTS).all(|(p, max)| *p <= max));
     }
+    let diagnoses = |name: &str| by_name[name].last().unwrap().as_str();
+    assert_eq!(diagnoses("no_shadows"), "no-shadows");
+    assert_eq!(diagnoses("gamma"), "gamma-applied");
+    assert_eq!(diagnoses("perfect"), "");
     let json: serde_json::Value = serde_json::from_str(&fs::read_to_string(out.join("grades.json")).unwrap()).unwrap();
     assert_eq!(json["students"].as_array().unwrap().len(), report.students.len());
     assert_eq!(json["rubric"]["max_points"], 4.0);
@@ -371,4 +395,51 @@ fn a_wide_class_table_keeps_names_and_lost_points_on_screen() {
         dom.contains("data-summary-in-view=\"true\""),
         "names and summaries stay on screen:\n{dom}"
     );
+}
+
+/// A report stays small when students pass: a passing picture that is not identical to the
+/// golden one is kept as a thumbnail with no heatmap; a picture that loses points keeps its full
+/// size and its heatmap.
+#[test]
+fn passing_pictures_are_thumbnails_and_only_lost_points_get_heatmaps() {
+    use goldray::film::{Tonemap, color_image};
+    use image::Rgb;
+
+    let dir = tempfile::tempdir().unwrap();
+    let scene = class::scene_path();
+    let rubric = format!(
+        "[defaults]\nthreshold = 8\npass_fraction = 0.01\n\n[render.spheres]\ncase = {scene:?}\nsize = [400, 400]\n\n[image.\"c.png\"]\nrender = \"spheres\"\n"
+    );
+    fs::write(dir.path().join("r.toml"), rubric).unwrap();
+    let mut case = goldray::case::load(&scene, &goldray::case::LoadOptions::default()).unwrap();
+    (case.render.trace.width, case.render.trace.height) = (400, 400);
+    let golden = color_image(&goldray::pipeline::render_case(&case).unwrap(), Tonemap::Clamp);
+    let mut nearly = golden.clone();
+    nearly.put_pixel(10, 10, Rgb([255, 0, 255]));
+    let mut broken = golden.clone();
+    for y in 0..200 {
+        for x in 0..400 {
+            broken.put_pixel(x, y, Rgb([0, 0, 0]));
+        }
+    }
+    for (name, picture) in [("nearly", &nearly), ("broken", &broken)] {
+        fs::create_dir_all(dir.path().join("subs").join(name)).unwrap();
+        picture.save(dir.path().join("subs").join(name).join("c.png")).unwrap();
+    }
+    let out = dir.path().join("report");
+    let options = GradeOptions {
+        out: out.clone(),
+        cache: Some(dir.path().join("cache")),
+    };
+    let report = grade_class(&dir.path().join("r.toml"), &dir.path().join("subs"), &options, &Silent).unwrap();
+    let nearly = &student(&report, "nearly").images[0];
+    assert_eq!(nearly.outcome, Outcome::Pass);
+    assert!(nearly.diff_image.is_none(), "no heatmap for full points");
+    let thumbnail = image::open(out.join(nearly.student_image.as_ref().unwrap())).unwrap();
+    assert_eq!((thumbnail.width(), thumbnail.height()), (300, 300));
+    let broken = &student(&report, "broken").images[0];
+    assert_eq!(broken.outcome, Outcome::Fail);
+    let full = image::open(out.join(broken.student_image.as_ref().unwrap())).unwrap();
+    assert_eq!((full.width(), full.height()), (400, 400));
+    assert!(out.join(broken.diff_image.as_ref().unwrap()).is_file());
 }

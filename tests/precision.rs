@@ -2,19 +2,18 @@
 //! the default one (bit-identical EXR on any thread count, the case file round trip) and draw
 //! the same picture within the golden tolerance, while actually computing in `f64`.
 
+mod util;
+
 use std::path::Path;
 
-use goldray::case::{Case, LoadOptions, case_to_toml, load, parse};
+use goldray::case::{Case, LoadOptions, case_to_toml, parse};
 use goldray::compare::{Image, Tolerance, Verdict, compare};
 use goldray::film::{Film, encode_exr};
 use goldray::options::Precision;
 use goldray::pipeline::render_case;
 
 fn case(name: &str, precision: Precision) -> Case {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("cases")
-        .join(format!("{name}.toml"));
-    let mut case = load(&path, &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    let mut case = util::load_shipped(name);
     case.render.precision = precision;
     case
 }

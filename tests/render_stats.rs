@@ -5,6 +5,7 @@
 mod cli;
 #[path = "render_stats/required.rs"]
 mod required;
+mod util;
 
 use std::path::Path;
 

@@ -4,9 +4,11 @@
 //! without writing anything. Images are tiny and timing runs single (`min_time` 0): speed is
 //! measured in benchmarks, never asserted here.
 
+mod util;
+
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Command;
 use std::time::Duration;
 
 use goldray::case::{Case, LoadOptions, parse};
@@ -16,6 +18,7 @@ use goldray::tradeoff::{
     CSV_COLUMNS, CSV_FILE, MARKDOWN_FILE, Metric, PLOT_FILE, PLOT_HEIGHT, PLOT_WIDTH, SweepPlan, Tradeoff,
     TradeoffOptions, measure_tradeoff, pareto_front, run_tradeoff,
 };
+use util::{goldray, shipped, stderr};
 
 fn case(toml: &str) -> Case {
     parse(toml, Path::new("tradeoff_test.toml"), &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"))
@@ -276,10 +279,6 @@ fn tiny_options(out: &Path) -> TradeoffOptions {
     }
 }
 
-fn shipped(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("cases").join(name)
-}
-
 #[test]
 fn the_report_reads_back_with_every_setting_and_the_plot_decodes() {
     let dir = tempfile::tempdir().unwrap();
@@ -382,17 +381,6 @@ fn the_target_is_the_fastest_setting_that_meets_it_or_a_clear_no() {
     assert_eq!(none.target.unwrap().chosen, None);
     let sentence = none.target_sentence().unwrap();
     assert!(sentence.starts_with("no setting reached FLIP mean ≤ 0;"), "{sentence}");
-}
-
-fn goldray(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_goldray"))
-        .args(args)
-        .output()
-        .expect("the goldray binary runs")
-}
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
 }
 
 const QUICK: [&str; 12] = [

@@ -13,14 +13,15 @@ mod objects;
 
 use std::path::Path;
 
-use lexer::{Lexer, Result, Token, Vec3, quote};
+use lexer::{Lexer, Result, Token, Vec3, comment_hint, quote};
 
 use super::RenderSettings;
-use super::error::{CaseError, suggest};
+use super::error::{CaseError, SourceLocation, suggest};
 use super::sections::MAX_BOUNCES;
 use super::spec::{BackgroundSpec, Case, MaterialSpec};
 use super::value::has_usable_length;
 use crate::film::Tonemap;
+use crate::located_toml::ReadError;
 use crate::options::{Filter, Precision, Profile, Trace};
 
 /// The course binary's command-line flags that shape a render (`-size`, `-bounces`, `-shadows`,
@@ -57,13 +58,24 @@ impl Default for AssignmentOptions {
 
 const BLOCKS: &[&str] = &["PerspectiveCamera", "Background", "Lights", "Materials", "Group"];
 
-/// The course sets this when the scene has no lights, so that unlit scenes show their colours.
+/// The course sets this when the latest `numLights` is 0 (or no Lights block was read), so that
+/// unlit scenes show their colours.
 const AMBIENT_WITHOUT_LIGHTS: [f64; 3] = [1.0; 3];
 
 pub fn load_assignment_scene(path: &Path, options: &AssignmentOptions) -> Result<Case> {
-    let source = std::fs::read_to_string(path).map_err(|source| CaseError::Read {
-        path: path.to_path_buf(),
-        source,
+    let bytes = ReadError::read(path, "case file")?;
+    let source = String::from_utf8(bytes).map_err(|e| {
+        let valid = e.utf8_error().valid_up_to();
+        let bytes = e.as_bytes();
+        let text = std::str::from_utf8(&bytes[..valid]).unwrap_or_default();
+        CaseError::Invalid {
+            location: SourceLocation::from_offset(path, text, valid),
+            message: format!(
+                "byte 0x{:02X} is not UTF-8: goldray reads scene files as UTF-8 text (the course's \
+                 parser takes any bytes, which matters only in file names); save the scene as UTF-8",
+                bytes[valid]
+            ),
+        }
     })?;
     parse_assignment_scene(&source, path, options)
 }
@@ -71,12 +83,20 @@ pub fn load_assignment_scene(path: &Path, options: &AssignmentOptions) -> Result
 /// `path` is not read: it names the scene in messages and anchors its relative asset paths.
 pub fn parse_assignment_scene(source: &str, path: &Path, options: &AssignmentOptions) -> Result<Case> {
     let render = render_settings(path, options)?;
+    if source.starts_with('\u{feff}') {
+        return Err(CaseError::Invalid {
+            location: SourceLocation::from_offset(path, source, 0),
+            message: "the file starts with a byte-order mark, which the course's parser reads as part \
+                      of the first word (and stops: \"Unknown token\"); save the scene without it"
+                .to_owned(),
+        });
+    }
     let dir = path.parent().unwrap_or(Path::new(""));
     let mut parser = Parser {
         lex: Lexer::new(path, source),
         dir,
         materials: Vec::new(),
-        block_materials: 0..0,
+        material_count: 0,
         current_material: None,
         depth: 0,
     };
@@ -88,13 +108,20 @@ pub fn parse_assignment_scene(source: &str, path: &Path, options: &AssignmentOpt
         cube_map: None,
     };
     let mut lights = Vec::new();
+    // `numLights` of the latest Lights block; the course starts from 0.
+    let mut light_count = 0;
     let mut objects = None;
-    // A repeated block replaces (or for Background, updates) the earlier one, as in the course.
+    // As in the course, a repeated PerspectiveCamera or Group replaces the earlier one, a
+    // Background updates the fields it names, and Lights and Materials blocks add up.
     while let Some(token) = parser.lex.word() {
         match token.text {
             "PerspectiveCamera" => camera = Some(parser.camera()?),
             "Background" => parser.background(&mut background)?,
-            "Lights" => lights = parser.lights()?,
+            "Lights" => {
+                let (block, count) = parser.lights()?;
+                lights.extend(block);
+                light_count = count;
+            }
             "Materials" => parser.materials()?,
             "Group" => objects = Some(parser.group()?),
             _ => return Err(parser.unknown(token, "block", BLOCKS, "blocks")),
@@ -108,7 +135,9 @@ pub fn parse_assignment_scene(source: &str, path: &Path, options: &AssignmentOpt
         .ok_or_else(|| missing("the scene has no PerspectiveCamera { center … direction … up … angle … } block"))?;
     let objects = objects
         .ok_or_else(|| missing("the scene has no top-level Group { numObjects N … } block, so nothing to render"))?;
-    if lights.is_empty() {
+    // The course tests the latest count, not the lights it holds: `numLights 0` after a block
+    // of lights still makes the ambient light white, and every light still shines.
+    if light_count == 0 {
         background.ambient = AMBIENT_WITHOUT_LIGHTS;
     }
     // The TOML schema forbids a colour beside a cube map, which replaces it; keeping the unused
@@ -128,6 +157,14 @@ pub fn parse_assignment_scene(source: &str, path: &Path, options: &AssignmentOpt
         materials: parser.materials,
         objects,
     })
+}
+
+/// Whether `v` survives normalisation both as written and as the course's `float`s, in which
+/// a length like 1e-30 squares to zero and normalising gives NaN.
+fn usable_in_single_precision(v: [f64; 3]) -> bool {
+    let [x, y, z] = v.map(|c| c as f32);
+    let length = (x * x + y * y + z * z).sqrt();
+    has_usable_length(v) && length > 0.0 && length.is_finite() && (1.0 / length).is_finite()
 }
 
 /// The options come from the command line, not the file, so their errors have no line.
@@ -172,8 +209,9 @@ struct Parser<'a> {
     dir: &'a Path,
     /// Every material of every Materials block, named `material0`, `material1`, … in order.
     materials: Vec<MaterialSpec>,
-    /// Which of `materials` the latest Materials block defined: `MaterialIndex k` means its k-th.
-    block_materials: std::ops::Range<usize>,
+    /// The latest Materials block's count: `MaterialIndex k` must be below it (and means the
+    /// k-th of `materials`, whichever block defined it).
+    material_count: usize,
     /// The course keeps one current material for the whole file and ignores group nesting:
     /// `MaterialIndex` inside a nested group still applies after the group closes.
     current_material: Option<usize>,
@@ -197,7 +235,7 @@ impl<'a> Parser<'a> {
     /// A vector that will be normalised downstream.
     fn direction(&mut self, label: &str) -> Result<Vec3<'a>> {
         let v = self.lex.vec3(&format!("3 numbers after `{label}`"))?;
-        if has_usable_length(v.value) {
+        if usable_in_single_precision(v.value) {
             Ok(v)
         } else {
             let rule = "must have a nonzero, finite length";
@@ -224,7 +262,9 @@ impl<'a> Parser<'a> {
     fn unknown(&self, token: Token, what: &str, valid: &[&str], noun: &str) -> CaseError {
         let tail = suggest(token.text, valid, noun);
         let found = quote(token.text);
-        self.lex.error_at(token.start, format!("unknown {what} {found}{tail}"))
+        let hint = comment_hint(token.text);
+        self.lex
+            .error_at(token.start, format!("unknown {what} {found}{tail}{hint}"))
     }
 
     /// A block closed before the count it announced; pointed at the closing brace.

@@ -1,20 +1,15 @@
 //! Errors that point at the spot in the case file a person has to edit.
 
-use std::io;
 use std::path::PathBuf;
 
-use crate::located_toml::LocatedError;
+use crate::located_toml::{LocatedError, ReadError};
 // The course-scene importer locates and words its own mistakes with these.
 pub(crate) use crate::located_toml::{SourceLocation, suggest};
 
 #[derive(Debug, thiserror::Error)]
 pub enum CaseError {
-    #[error("{}: cannot read case file: {source}", path.display())]
-    Read {
-        path: PathBuf,
-        #[source]
-        source: io::Error,
-    },
+    #[error(transparent)]
+    Read(#[from] ReadError),
     /// A mistake in a TOML case file, at its line and column.
     #[error(transparent)]
     Toml(#[from] LocatedError),
@@ -33,7 +28,7 @@ impl CaseError {
         match self {
             CaseError::Toml(error) => Some(error.location()),
             CaseError::Invalid { location, .. } => Some(location),
-            CaseError::Read { .. } | CaseError::Missing { .. } => None,
+            CaseError::Read(_) | CaseError::Missing { .. } => None,
         }
     }
 }

@@ -18,11 +18,28 @@ pub fn case_to_toml(case: &Case, toml_path: &Path) -> String {
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
+    write_case(case, Some(base))
+}
+
+/// [`case_to_toml`] for a file whose location is unknown (standard output, which may be
+/// redirected anywhere): asset paths are absolute, so the case loads wherever it is saved.
+pub fn case_to_toml_anywhere(case: &Case) -> String {
+    write_case(case, None)
+}
+
+/// Asset paths relative to `base`, or absolute without one.
+fn write_case(case: &Case, base: Option<&Path>) -> String {
     let writer = Writer { case, base };
     let defaults = defaults(case.render.profile);
+    let paths = match base {
+        Some(_) => "Paths are relative to this file",
+        None => {
+            "Paths are absolute (it was written to standard output; `goldray import -o FILE` writes \
+             them relative to FILE)"
+        }
+    };
     let mut out = format!(
-        "# Imported from {} by goldray.\n# Paths are relative to this file; keys left out take \
-         their default values.\n",
+        "# Imported from {} by goldray.\n# {paths}; keys left out take their default values.\n",
         writer.path(&case.path)
     );
     if let Some(description) = &case.description {
@@ -86,7 +103,8 @@ fn defaults(profile: Profile) -> Case {
 
 struct Writer<'a> {
     case: &'a Case,
-    base: &'a Path,
+    /// Where asset paths are relative to; `None`: they are absolute.
+    base: Option<&'a Path>,
 }
 
 impl Writer<'_> {
@@ -223,7 +241,7 @@ impl Writer<'_> {
     }
 
     fn path(&self, path: &Path) -> String {
-        relative(path, self.base).unwrap_or_else(|| {
+        self.base.and_then(|base| relative(path, base)).unwrap_or_else(|| {
             lexical_absolute(path)
                 .unwrap_or_else(|| path.to_path_buf())
                 .to_string_lossy()

@@ -20,14 +20,14 @@ use std::path::Path;
 pub use crate::located_toml::SourceLocation;
 pub use assignment::{AssignmentOptions, load_assignment_scene, parse_assignment_scene};
 pub use error::CaseError;
-pub use export::case_to_toml;
+pub use export::{case_to_toml, case_to_toml_anywhere};
 pub use sections::MAX_BOUNCES;
 pub use spec::{
     BackgroundSpec, CameraSpec, Case, LightSpec, MaterialSpec, ObjectSpec, RenderSettings, ShapeSpec, TransformOp,
     composite_matrix,
 };
 
-use crate::located_toml::{self, Doc, Table};
+use crate::located_toml::{self, Doc, ReadError, Table};
 
 #[derive(Clone, Debug, Default)]
 pub struct LoadOptions {
@@ -47,10 +47,7 @@ const TOP_LEVEL_KEYS: &[&str] = &[
 ];
 
 pub fn load(path: &Path, options: &LoadOptions) -> Result<Case, CaseError> {
-    let source = std::fs::read_to_string(path).map_err(|source| CaseError::Read {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let source = ReadError::read_text(path, "case file")?;
     parse(&source, path, options)
 }
 

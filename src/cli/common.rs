@@ -54,13 +54,6 @@ where
     text.trim().parse().map_err(|error: T::Err| error.to_string())
 }
 
-/// An image size as one argument, `WxH` (also `W×H`, `WXH`).
-pub fn parse_size(text: &str) -> Result<(u32, u32), String> {
-    let usage = || format!("`{text}` is not a size: give WIDTHxHEIGHT, e.g. 64x48, or WIDTH HEIGHT");
-    let (width, height) = text.split_once(['x', 'X', '×']).ok_or_else(usage)?;
-    size_from_sides(width, height, SizeLimit::Fixed)
-}
-
 /// An image size given as two arguments, `W H`, or as one, `WxH`, checked against the size rule.
 pub fn size_from_values(values: &[String], limit: SizeLimit) -> Result<(u32, u32), String> {
     match values {
@@ -122,10 +115,18 @@ mod tests {
             size_from_values(&values(&["800x600"]), SizeLimit::Forceable),
             Ok((800, 600))
         );
-        assert_eq!(parse_size("64x48"), Ok((64, 48)));
-        assert!(parse_size("64").unwrap_err().contains("WIDTHxHEIGHT"));
-        assert!(parse_size("0x10").unwrap_err().contains("between 1"));
-        assert!(parse_size("99999x10").unwrap_err().contains("16384"));
+        assert!(
+            size_from_values(&values(&["64"]), SizeLimit::Fixed)
+                .unwrap_err()
+                .contains("WIDTHxHEIGHT")
+        );
+        assert!(
+            size_from_values(&values(&["0x10"]), SizeLimit::Fixed)
+                .unwrap_err()
+                .contains("between 1")
+        );
+        let fixed = size_from_values(&values(&["99999x10"]), SizeLimit::Fixed).unwrap_err();
+        assert!(fixed.contains("16384") && !fixed.contains("--force"), "{fixed}");
         let negative = size_from_values(&values(&["-400", "400"]), SizeLimit::Forceable).unwrap_err();
         assert!(negative.contains("must be between 1 and 16384"), "{negative}");
         let big = size_from_values(&values(&["20000", "10"]), SizeLimit::Forceable).unwrap_err();

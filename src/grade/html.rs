@@ -9,9 +9,11 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+mod mistakes;
+
 use super::golden::GOLDEN_DIR;
 use super::outcome::Outcome;
-use super::report::{ClassReport, format_points};
+use super::report::{ClassReport, flags, format_points};
 use super::score::{ImageResult, StudentResult, percent};
 use crate::atomic_write::write_file_atomic;
 use crate::compare::Metrics;
@@ -30,7 +32,8 @@ th{background:#eee;font-weight:600;vertical-align:bottom}td.name{text-align:left
 #grades td.lost{text-align:left;min-width:12em;max-width:24em;font-size:.9em}
 img.thumb{display:block;width:48px;height:48px;margin:.2em auto 0;object-fit:contain}
 .v-pass{background:#c8e6c9}.v-partial{background:#ffe0a3}.v-fail{background:#f4b4b4}
-.v-missing,.v-wrong-size,.v-wrong-format,.v-too-large,.v-unreadable{background:#d7c8ee}
+.v-missing,.v-wrong-size,.v-wrong-format,.v-too-large,.v-unreadable,.v-linked{background:#d7c8ee}
+.flag{background:#fff3cd;border:1px solid #e0b000;padding:.1em .4em;border-radius:.3em}
 .badge{display:inline-block;padding:0 .5em;border-radius:.8em;font-size:.85em;font-weight:600}
 .chips{display:flex;flex-wrap:wrap;gap:.3em}.chips a{color:#222;text-decoration:none}
 section.image{background:#fff;border:1px solid #ccc;border-left-width:6px;margin:1em 0;padding:.8em}
@@ -99,8 +102,9 @@ fn page(title: &str, body: &str) -> String {
     format!(
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
          <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
-         <title>{}</title>\n<style>{STYLE}</style>\n</head>\n<body>\n{body}<script>{SCRIPT}</script>\n</body>\n</html>\n",
-        escape(title)
+         <title>{}</title>\n<style>{STYLE}{}</style>\n</head>\n<body>\n{body}<script>{SCRIPT}</script>\n</body>\n</html>\n",
+        escape(title),
+        mistakes::STYLE
     )
 }
 
@@ -119,6 +123,7 @@ fn index(report: &ClassReport) -> String {
         escape(&rubric.path.display().to_string()),
         report.goldray,
     );
+    mistakes::histogram(&mut body, report);
     // The student column stays put while the per-image cells scroll; the summary before them
     // names the images that lost points, so a wide rubric never hides a failure off screen.
     body.push_str(
@@ -181,7 +186,66 @@ fn index(report: &ClassReport) -> String {
         );
     }
     body.push_str(LEGEND);
+    integrity_section(&mut body, report);
     page(&format!("Grades: {}", rubric.title), &body)
+}
+
+/// What grading noticed about where pictures came from: flagged images, and pairs of students
+/// who handed in the same picture. Evidence for the TA, not verdicts.
+fn integrity_section(body: &mut String, report: &ClassReport) {
+    body.push_str("<section id=\"integrity\">\n<h2>Where the pictures came from</h2>\n");
+    let flagged: Vec<&StudentResult> = report.students.iter().filter(|s| !flags(s).is_empty()).collect();
+    if flagged.is_empty() {
+        body.push_str("<p class=\"muted\">No image is flagged.</p>\n");
+    } else {
+        body.push_str("<ul class=\"flagged\">\n");
+        for student in flagged {
+            let items: Vec<String> = flags(student).iter().map(|f| escape(f)).collect();
+            let _ = writeln!(
+                body,
+                "<li><a href=\"{}\">{}</a>: <span class=\"flag\">{}</span></li>",
+                escape(&student.page),
+                escape(&student.name),
+                items.join("</span> <span class=\"flag\">")
+            );
+        }
+        body.push_str("</ul>\n");
+    }
+    body.push_str("<h3>Similar submissions</h3>\n");
+    if report.similar.is_empty() {
+        body.push_str(
+            "<p class=\"muted\">No two students handed in the same picture (pictures identical to the golden \
+             or published ones aside).</p>\n",
+        );
+    } else {
+        body.push_str("<ul class=\"similar\">\n");
+        let page_of = |name: &str| {
+            report
+                .students
+                .iter()
+                .find(|s| s.name == name)
+                .map_or(String::new(), |s| escape(&s.page))
+        };
+        for pair in &report.similar {
+            let [a, b] = &pair.students;
+            let files: Vec<String> = pair.files.iter().map(|f| escape(f)).collect();
+            let _ = writeln!(
+                body,
+                "<li><a href=\"{}\">{}</a> and <a href=\"{}\">{}</a>: {}</li>",
+                page_of(a),
+                escape(a),
+                page_of(b),
+                escape(b),
+                files.join(", ")
+            );
+        }
+        body.push_str(
+            "</ul>\n<p class=\"muted\">The same picture, or a failing picture with more than 99.99% \
+             of its pixels the same. Two students who made the same mistake can render the same \
+             picture: this is a place to look, not a finding.</p>\n",
+        );
+    }
+    body.push_str("</section>\n");
 }
 
 /// The images that did not get full points, most points lost first (rubric order among equals),
@@ -232,7 +296,8 @@ const LEGEND: &str = "<p class=\"muted\">\
 <span class=\"badge v-pass\">pass</span> full points · \
 <span class=\"badge v-partial\">partial</span> partial credit · \
 <span class=\"badge v-fail\">fail</span> too different from the golden image · \
-<span class=\"badge v-missing\">missing, wrong size, wrong format, too large, unreadable</span> nothing to compare. \
+<span class=\"badge v-missing\">missing, wrong size, wrong format, too large, unreadable, linked</span> nothing to compare \
+(linked: a symbolic link, or a file outside the student's folder, is not read). \
 Hover a cell for the reason; click it for the pictures.</p>\n";
 
 fn student_page(report: &ClassReport, student: &StudentResult) -> String {
@@ -245,6 +310,9 @@ fn student_page(report: &ClassReport, student: &StudentResult) -> String {
         escape(&student.folder.display().to_string()),
         escape(&report.rubric.title),
     );
+    for flag in flags(student) {
+        let _ = writeln!(body, "<p><span class=\"flag\">{}</span></p>", escape(&flag));
+    }
     // Every image at a glance, in rubric order; each chip jumps to its section.
     body.push_str("<nav class=\"chips\">");
     for result in &student.images {
@@ -259,6 +327,7 @@ fn student_page(report: &ClassReport, student: &StudentResult) -> String {
         );
     }
     body.push_str("</nav>\n");
+    mistakes::summary(&mut body, student);
     // Lost points first, the largest share lost first; rubric order among equals.
     let mut order: Vec<&ImageResult> = student.images.iter().collect();
     order.sort_by(|a, b| earned(a).total_cmp(&earned(b)));
@@ -284,6 +353,10 @@ fn image_section(body: &mut String, result: &ImageResult) {
         format_points(result.max_points),
         escape(&result.explanation),
     );
+    for flag in &result.flags {
+        let _ = writeln!(body, "<p><span class=\"flag\">{}</span></p>", escape(flag));
+    }
+    mistakes::image_line(body, result);
     if !result.notes.is_empty() {
         body.push_str("<ul>");
         for note in &result.notes {

@@ -20,13 +20,16 @@
 //! # }
 //! ```
 
+mod diagnose;
 mod error;
 mod golden;
 mod html;
+mod integrity;
 mod outcome;
 mod report;
 mod rubric;
 mod score;
+mod similarity;
 mod submission;
 
 use std::collections::BTreeMap;
@@ -37,12 +40,19 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use rayon::prelude::*;
 
 use crate::progress::Progress;
+pub use diagnose::{
+    Closest, Confidence, Diagnosis, DiagnosisRun, FAILING_REDUCTION, MISTAKES_DIR, RMSE_REDUCTION, RenderDiagnosis,
+    Residual, UNEXPLAINED, explains, loses_points,
+};
 pub use error::{GradeError, RubricError};
 pub use golden::{GoldenRender, Goldens, default_cache_dir, prepare_goldens};
+pub use integrity::{Integrity, LinkPolicy, PUBLISHED_COPY};
 pub use outcome::Outcome;
-pub use report::{ClassReport, RubricSummary};
+pub use report::{ClassReport, RubricSummary, diagnoses_of, flags, mistakes_of};
 pub use rubric::{ImageSpec, Output, RenderSource, Rubric, Rule, load_rubric, parse_rubric};
 pub use score::{ImageResult, StudentResult, Submission, grade_image, judge};
+use similarity::similar_pairs;
+pub use similarity::{NEAR_IDENTICAL, SimilarPair};
 
 /// Where the report and the golden cache go.
 #[derive(Clone, Debug)]
@@ -52,14 +62,33 @@ pub struct GradeOptions {
     pub cache: Option<PathBuf>,
 }
 
+/// Whether grading names the mistake behind each image that lost points (see [`Diagnosis`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Diagnose {
+    Yes,
+    No,
+}
+
 /// Loads the rubric, prepares the goldens, grades every student folder of `submissions` on the
-/// current rayon pool and writes the whole report. Golden renders, then graded students, are
-/// reported to `progress`. Returns an error only when grading could not run; what students
-/// handed in never makes it fail.
+/// current rayon pool, diagnoses the images that lost points and writes the whole report.
+/// Golden renders, then graded students, then diagnosed images are reported to `progress`.
+/// Returns an error only when grading could not run; what students handed in never makes it
+/// fail.
 pub fn grade_class(
     rubric_path: &Path,
     submissions: &Path,
     options: &GradeOptions,
+    progress: &dyn Progress,
+) -> Result<ClassReport, GradeError> {
+    grade_class_diagnosing(rubric_path, submissions, options, Diagnose::Yes, progress)
+}
+
+/// [`grade_class`], diagnosing or not.
+pub fn grade_class_diagnosing(
+    rubric_path: &Path,
+    submissions: &Path,
+    options: &GradeOptions,
+    diagnose: Diagnose,
     progress: &dyn Progress,
 ) -> Result<ClassReport, GradeError> {
     let rubric = load_rubric(rubric_path)?;
@@ -79,6 +108,7 @@ pub fn grade_class(
     // One task per image rather than per student, so that both cores stay busy to the end of a
     // small class.
     let per_student = rubric.images.len();
+    let published = integrity::published_hashes(&rubric.integrity, &rubric.images);
     progress.begin("grading", (folders.len() * per_student) as u64);
     // Images left per student, so that the last one to finish can say the student is done.
     let left: Vec<AtomicUsize> = folders.iter().map(|_| AtomicUsize::new(per_student)).collect();
@@ -86,7 +116,15 @@ pub fn grade_class(
         .into_par_iter()
         .map(|task| {
             let (student, image) = (task / per_student, task % per_student);
-            let result = grade_image(&rubric.images[image], &goldens.images[image], &folders[student], out);
+            let spec = &rubric.images[image];
+            let result = grade_image(
+                spec,
+                &goldens.images[image],
+                &folders[student],
+                &rubric.integrity,
+                published.get(&spec.file).copied(),
+                out,
+            );
             progress.advance(1);
             if left[student].fetch_sub(1, Ordering::Relaxed) == 1 {
                 progress.done(&folders[student].name);
@@ -96,10 +134,34 @@ pub fn grade_class(
         .collect::<Result<Vec<_>, _>>()?;
     progress.finish();
     let mut results = results.into_iter();
-    let students = folders
+    let mut students: Vec<StudentResult> = folders
         .iter()
         .map(|submission| StudentResult::new(submission, results.by_ref().take(per_student).collect()))
         .collect();
+    let diagnosis = if diagnose == Diagnose::Yes {
+        let run = diagnose::diagnose_class(&rubric, &goldens, &cache, &mut students, out, progress)?;
+        diagnose::prefer_consistent(&mut students);
+        diagnose::apply_credit(&rubric, &mut students);
+        Some(run)
+    } else {
+        None
+    };
+    let similar = similar_pairs(
+        &students
+            .iter()
+            .flat_map(|student| {
+                student.images.iter().enumerate().filter_map(|(order, image)| {
+                    Some(similarity::Entry {
+                        student: &student.name,
+                        file: &image.file,
+                        order,
+                        path: image.graded_file.as_deref()?,
+                        fingerprint: image.fingerprint.as_ref()?,
+                    })
+                })
+            })
+            .collect::<Vec<_>>(),
+    );
 
     let report = ClassReport {
         goldray: env!("CARGO_PKG_VERSION"),
@@ -107,8 +169,10 @@ pub fn grade_class(
         submissions: submissions.to_path_buf(),
         cache: cache.clone(),
         goldens: goldens.renders,
+        diagnosis,
         ignored,
         students,
+        similar,
     };
     report::write_data(&report, out)?;
     html::write_html(&report, out)?;

@@ -23,6 +23,9 @@ pub enum Outcome {
     TooLarge { reason: String },
     /// A PNG that cannot be decoded (truncated, corrupt), or a file that cannot be read.
     Unreadable { reason: String },
+    /// A symbolic link, or a file that resolves outside the student's folder: not read, because
+    /// it is not the student's own file. The reason says where it points.
+    Linked { reason: String },
 }
 
 impl Outcome {
@@ -36,6 +39,7 @@ impl Outcome {
             Outcome::WrongFormat { .. } => "wrong format",
             Outcome::TooLarge { .. } => "too large",
             Outcome::Unreadable { .. } => "unreadable",
+            Outcome::Linked { .. } => "linked",
         }
     }
 }

@@ -1,14 +1,16 @@
 //! The class report and its machine-readable forms: `grades.csv` for the spreadsheet the grades
 //! end up in, `grades.json` with everything for scripts.
 
-use std::collections::HashSet;
+use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
+use super::diagnose::DiagnosisRun;
 use super::golden::GoldenRender;
 use super::rubric::{ImageSpec, Rubric};
 use super::score::StudentResult;
+use super::similarity::SimilarPair;
 use crate::atomic_write::write_file_atomic;
 use crate::film::OutputError;
 
@@ -22,10 +24,14 @@ pub struct ClassReport {
     /// Where the golden renders were cached.
     pub cache: PathBuf,
     pub goldens: Vec<GoldenRender>,
+    /// What diagnosing the images that lost points cost; `None` when grading did not diagnose.
+    pub diagnosis: Option<DiagnosisRun>,
     /// Entries of the submissions folder that are not student folders (loose files), by name.
     pub ignored: Vec<String>,
     /// By folder name.
     pub students: Vec<StudentResult>,
+    /// Pairs of students who handed in the same picture, or nearly the same failing one.
+    pub similar: Vec<SimilarPair>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -34,6 +40,9 @@ pub struct RubricSummary {
     pub title: String,
     pub max_points: f64,
     pub images: Vec<ImageSpec>,
+    /// The rubric's credit per diagnosed mistake, by catalogue id (absent: none).
+    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    pub mistake_credit: BTreeMap<String, f64>,
 }
 
 impl RubricSummary {
@@ -43,6 +52,11 @@ impl RubricSummary {
             title: rubric.title.clone(),
             max_points: rubric.images.iter().map(|i| i.points).sum(),
             images: rubric.images.clone(),
+            mistake_credit: rubric
+                .mistake_credit
+                .iter()
+                .map(|(f, c)| (f.name().to_owned(), *c))
+                .collect(),
         }
     }
 }
@@ -57,12 +71,13 @@ pub fn write_data(report: &ClassReport, out: &Path) -> Result<(), OutputError> {
     Ok(())
 }
 
-/// One row per student: the folder name, the points of each image in rubric order, the total.
+/// One row per student: the folder name, the points of each image in rubric order, the total,
+/// and the flags on the student's images (`a01.png: identical to the published reference; …`).
 pub fn grades_csv(report: &ClassReport) -> String {
     let mut csv = String::new();
     let header = std::iter::once("student")
         .chain(report.rubric.images.iter().map(|i| i.file.as_str()))
-        .chain(["total"])
+        .chain(["total", "flags", "diagnoses"])
         .map(csv_field)
         .collect::<Vec<_>>();
     csv.push_str(&header.join(","));
@@ -70,12 +85,49 @@ pub fn grades_csv(report: &ClassReport) -> String {
     for student in &report.students {
         let row = std::iter::once(csv_field(&student.name))
             .chain(student.images.iter().map(|i| format_points(i.points)))
-            .chain([format_points(student.total)])
+            .chain([
+                format_points(student.total),
+                csv_field(&flags(student).join("; ")),
+                csv_field(&diagnoses_of(student).join("; ")),
+            ])
             .collect::<Vec<_>>();
         csv.push_str(&row.join(","));
         csv.push_str("\r\n");
     }
     csv
+}
+
+/// Each flag of a student's images, as `FILE: flag`.
+/// The diagnoses of a student's images, each id once, in rubric order: `no-shadows`,
+/// `no-shadows+gamma-applied`, `unexplained`.
+pub fn diagnoses_of(student: &StudentResult) -> Vec<String> {
+    let mut ids: Vec<String> = Vec::new();
+    for diagnosis in student.images.iter().filter_map(|i| i.diagnosis.as_ref()) {
+        if !ids.contains(&diagnosis.id) {
+            ids.push(diagnosis.id.clone());
+        }
+    }
+    ids
+}
+
+/// The mistakes a student made, each catalogue id once (a pair's two apart), and `unexplained`
+/// if some image is: what the class histogram counts.
+pub fn mistakes_of(student: &StudentResult) -> Vec<String> {
+    let mut ids: Vec<String> = Vec::new();
+    for id in diagnoses_of(student).iter().flat_map(|id| id.split('+')) {
+        if !ids.iter().any(|known| known == id) {
+            ids.push(id.to_owned());
+        }
+    }
+    ids
+}
+
+pub fn flags(student: &StudentResult) -> Vec<String> {
+    student
+        .images
+        .iter()
+        .flat_map(|image| image.flags.iter().map(move |flag| format!("{}: {flag}", image.file)))
+        .collect()
 }
 
 /// RFC 4180 quoting, and a leading `'` on anything a spreadsheet would run as a formula: folder

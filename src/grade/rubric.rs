@@ -9,9 +9,12 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use super::error::RubricError;
+use super::integrity::{Integrity, integrity};
 use crate::case::{self, AssignmentOptions, Case, LoadOptions, MAX_BOUNCES, load_assignment_scene};
+use crate::fault::Fault;
 use crate::image_size::{MAX_IMAGE_SIZE, SizeLimit, check_side};
-use crate::located_toml::{self, Doc, Field, SourceLocation, Table, suggest};
+use crate::located_toml::{self, Doc, Field, ReadError, SourceLocation, Table, suggest};
+use crate::named_enum::NamedEnum;
 use crate::named_enum::named_enum;
 
 /// A whole rubric, every path resolved and every render source loaded.
@@ -23,6 +26,11 @@ pub struct Rubric {
     pub renders: Vec<RenderSource>,
     /// In file order, which is the column order of every report.
     pub images: Vec<ImageSpec>,
+    /// What grading checks about where submitted files come from.
+    pub integrity: Integrity,
+    /// `[mistake."ID"] credit = c`: the share of an image's points granted when its diagnosis
+    /// is that mistake (or a pair of credited mistakes: the product), in file order.
+    pub mistake_credit: Vec<(Fault, f64)>,
 }
 
 /// One `[render.NAME]`: a render that one or more images are taken from.
@@ -95,7 +103,7 @@ const DEFAULT_RULE: Rule = Rule {
 };
 const DEFAULT_POINTS: f64 = 1.0;
 
-const TOP_KEYS: &[&str] = &["title", "defaults", "render", "image"];
+const TOP_KEYS: &[&str] = &["title", "defaults", "render", "image", "integrity", "mistake"];
 const RULE_KEYS: &[&str] = &[
     "threshold",
     "pass_fraction",
@@ -113,10 +121,7 @@ const SCENE_ONLY_KEYS: &[&str] = &["bounces", "shadows", "jitter", "filter"];
 type Result<T> = std::result::Result<T, RubricError>;
 
 pub fn load_rubric(path: &Path) -> Result<Rubric> {
-    let source = std::fs::read_to_string(path).map_err(|source| RubricError::Read {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let source = ReadError::read_text(path, "the rubric")?;
     parse_rubric(&source, path)
 }
 
@@ -158,6 +163,14 @@ pub fn parse_rubric(source: &str, path: &Path) -> Result<Rubric> {
             images.push(image_spec(&entry, &renders, &base_rule, base_points)?);
         }
     }
+    let integrity = match top.get("integrity") {
+        Some(field) => integrity(&field.table("[integrity]".to_owned())?)?,
+        None => Integrity::default(),
+    };
+    let mistake_credit = match top.get("mistake") {
+        Some(field) => mistake_credit(&field.table("[mistake]".to_owned())?)?,
+        None => Vec::new(),
+    };
     if images.is_empty() {
         return Err(RubricError::Missing {
             file: path.to_path_buf(),
@@ -172,7 +185,34 @@ pub fn parse_rubric(source: &str, path: &Path) -> Result<Rubric> {
         }),
         renders,
         images,
+        integrity,
+        mistake_credit,
     })
+}
+
+/// `[mistake."no-shadows"] credit = 0.5`, one table per catalogue id.
+fn mistake_credit(table: &Table) -> Result<Vec<(Fault, f64)>> {
+    let mut credits = Vec::new();
+    for entry in table.fields() {
+        let Some(fault) = Fault::from_name(&entry.name) else {
+            let tail = suggest(&entry.name, crate::fault::ids(), "mistakes");
+            return Err(entry
+                .doc
+                .error_at(
+                    &entry.key_span,
+                    format!("`{}` is not a mistake of the catalogue{tail}", entry.name),
+                )
+                .into());
+        };
+        let mistake = entry.table(format!("[mistake.\"{}\"]", entry.name))?;
+        mistake.check_keys(&["credit"])?;
+        let credit = mistake.require("credit")?;
+        match credit.number()? {
+            v if (0.0..=1.0).contains(&v) => credits.push((fault, v)),
+            _ => return Err(credit.invalid("must be between 0 and 1").into()),
+        }
+    }
+    Ok(credits)
 }
 
 fn render_source(entry: &Field) -> Result<RenderSource> {

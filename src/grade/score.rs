@@ -5,9 +5,12 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
+use super::diagnose::Diagnosis;
 use super::golden::GOLDEN_DIR;
+use super::integrity::{Integrity, PUBLISHED_COPY, pixel_hash, refuse_link};
 use super::outcome::Outcome;
 use super::rubric::{ImageSpec, Rule};
+use super::similarity::Fingerprint;
 use super::submission::{Folder, read_png};
 use crate::atomic_write::write_file_atomic;
 use crate::compare::{Image, Metrics, Tolerance, compare, diff_heatmap};
@@ -32,6 +35,17 @@ pub struct ImageResult {
     /// The diff heatmap, relative to the report directory.
     pub diff_image: Option<String>,
     pub metrics: Option<Metrics>,
+    /// Which mistake explains the image, only for an image that lost points on a comparison
+    /// (and only when grading diagnoses).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub diagnosis: Option<Diagnosis>,
+    /// Evidence for the TA about where the picture came from ("identical to the published
+    /// reference"); it changes the points only where the rubric says so.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub flags: Vec<String>,
+    /// What finding copies between students needs; not part of the report.
+    #[serde(skip)]
+    pub fingerprint: Option<Fingerprint>,
 }
 
 /// All of one student's results, in rubric order.
@@ -85,15 +99,24 @@ impl StudentResult {
             images,
         }
     }
+
+    /// The total again, after points changed (credit for a diagnosed mistake).
+    pub fn recount(&mut self) {
+        self.total = self.images.iter().map(|i| i.points).sum();
+    }
 }
 
 /// Grades one expected image of one submission against its golden picture, writing the student's
 /// picture and the diff heatmap under `out` when they differ from the golden. Whatever the file,
 /// the result is a verdict; only a failure to write the report is an error.
+/// Grades one expected file of one student. `published` is the pixel hash of the published
+/// reference image of this file, when the rubric names a published folder that has it.
 pub fn grade_image(
     spec: &ImageSpec,
     golden: &Image,
     submission: &Submission,
+    integrity: &Integrity,
+    published: Option<u64>,
     out: &Path,
 ) -> Result<ImageResult, OutputError> {
     let (folder, dir) = (&submission.files, submission.dir());
@@ -108,6 +131,9 @@ pub fn grade_image(
         student_image: None,
         diff_image: None,
         metrics: None,
+        diagnosis: None,
+        flags: Vec::new(),
+        fingerprint: None,
     };
     let located = match (&folder.error, folder.find(&spec.file)) {
         (Some(reason), _) => return Ok(refused(result, Outcome::Unreadable { reason: reason.clone() })),
@@ -116,14 +142,22 @@ pub fn grade_image(
     };
     result.notes.extend(located.note);
     result.graded_file = Some(located.path.clone());
+    if let Some(reason) = refuse_link(&located.path, &submission.path, integrity.links) {
+        return Ok(refused(result, Outcome::Linked { reason }));
+    }
     let submitted = match read_png(&located.path) {
         Ok(submitted) => submitted,
         Err(outcome) => return Ok(refused(result, outcome)),
     };
     result.notes.extend(submitted.notes);
 
+    let copy_of_published = published.is_some_and(|hash| hash == pixel_hash(&submitted.picture));
+    if copy_of_published {
+        result.flags.push(PUBLISHED_COPY.to_owned());
+    }
+    let picture = submitted.picture;
     let copy = format!("{dir}/{}", spec.file);
-    let actual = Image::from_rgb8(submitted.picture, located.path);
+    let actual = Image::from_rgb8(picture.clone(), located.path);
     let tolerance = Tolerance {
         pixel: spec.rule.threshold,
         fail_fraction: spec.rule.pass_fraction,
@@ -138,12 +172,19 @@ pub fn grade_image(
             expected: [golden.width, golden.height],
             actual: [actual.width, actual.height],
         };
+        result.fingerprint = (!copy_of_published).then(|| Fingerprint::of(&picture, true));
         return Ok(refused(result, outcome));
     };
+    let (outcome, mut explanation) = judge(&spec.rule, &metrics);
     if metrics.worst.is_none() {
         // Identical: the golden picture stands in for the student's, and there is no difference
         // to draw, which keeps the report of a good class small.
         result.student_image = Some(format!("{GOLDEN_DIR}/{}", spec.file));
+    } else if outcome == Outcome::Pass {
+        // Full points: a thumbnail shows what was handed in; there is nothing for the student to
+        // find in a full-size copy or a heatmap, and a class that passes keeps a small report.
+        write_file_atomic(&out.join(&copy), &encode_png(&thumbnail(&actual.preview))?)?;
+        result.student_image = Some(copy);
     } else {
         write_file_atomic(&out.join(&copy), &encode_png(&actual.preview)?)?;
         result.student_image = Some(copy);
@@ -154,16 +195,41 @@ pub fn grade_image(
             result.diff_image = Some(diff);
         }
     }
-    let (outcome, explanation) = judge(&spec.rule, &metrics);
     result.points = match outcome {
         Outcome::Pass => spec.points,
         Outcome::Partial => spec.points * spec.rule.partial_credit,
         _ => 0.0,
     };
+    if copy_of_published && integrity.published_copy_credit < 1.0 {
+        result.points *= integrity.published_copy_credit;
+        explanation.push_str(&format!(
+            " The picture is identical to the published reference: the rubric keeps {} of its points.",
+            percent(integrity.published_copy_credit)
+        ));
+    }
+    // Matching the golden or the published answer is not copying a classmate.
+    if metrics.worst.is_some() && !copy_of_published {
+        result.fingerprint = Some(Fingerprint::of(&picture, outcome != Outcome::Pass));
+    }
     result.outcome = outcome;
     result.explanation = explanation;
     result.metrics = Some(metrics);
     Ok(result)
+}
+
+/// The side of the square a passing picture's thumbnail fits in: the report shows pictures 300
+/// pixels wide.
+const THUMBNAIL: u32 = 300;
+
+/// `picture` shrunk (never enlarged) to fit a [`THUMBNAIL`] square, keeping its aspect.
+fn thumbnail(picture: &image::RgbImage) -> image::RgbImage {
+    let (width, height) = picture.dimensions();
+    let longest = width.max(height);
+    if longest <= THUMBNAIL {
+        return picture.clone();
+    }
+    let scale = |side: u32| ((u64::from(side) * u64::from(THUMBNAIL)) / u64::from(longest)).max(1) as u32;
+    image::imageops::thumbnail(picture, scale(width), scale(height))
 }
 
 /// A result with nothing compared: no points, and the outcome's reason as the explanation.
@@ -175,7 +241,7 @@ fn refused(mut result: ImageResult, outcome: Outcome) -> ImageResult {
             actual[0], actual[1], expected[0], expected[1]
         ),
         Outcome::WrongFormat { found } => format!("the file is {found}, not a PNG"),
-        Outcome::TooLarge { reason } | Outcome::Unreadable { reason } => reason.clone(),
+        Outcome::TooLarge { reason } | Outcome::Unreadable { reason } | Outcome::Linked { reason } => reason.clone(),
         Outcome::Pass | Outcome::Partial | Outcome::Fail => String::new(),
     };
     result.outcome = outcome;

@@ -23,7 +23,7 @@ use std::path::Path;
 use toml::Spanned;
 use toml::de::DeTable;
 
-pub use self::error::LocatedError;
+pub use self::error::{LocatedError, ReadError};
 pub use self::location::SourceLocation;
 pub(crate) use self::reader::{Field, Table};
 pub(crate) use self::suggest::suggest;
@@ -32,10 +32,58 @@ pub(crate) type Result<T> = std::result::Result<T, LocatedError>;
 
 /// Parses `text` into the tree the readers walk; `file` names it in the syntax error.
 pub(crate) fn parse<'i>(text: &'i str, file: &Path) -> Result<Spanned<DeTable<'i>>> {
-    DeTable::parse(text).map_err(|e| LocatedError::Syntax {
-        location: SourceLocation::from_offset(file, text, e.span().map_or(0, |s| s.start)),
-        message: e.message().to_owned(),
+    DeTable::parse(text).map_err(|e| {
+        let at = e.span().map_or(0, |s| s.start);
+        let message = match e.message() {
+            "duplicate key" => duplicate_key(text, at),
+            other => other.to_owned(),
+        };
+        LocatedError::Syntax {
+            location: SourceLocation::from_offset(file, text, at),
+            message,
+        }
     })
+}
+
+/// toml says only "duplicate key"; a person needs the key and where it was first given. `at` is
+/// the second occurrence: a key (`bounces = 2`) or a table header (`[render]`).
+fn duplicate_key(text: &str, at: usize) -> String {
+    let rest = &text[at.min(text.len())..];
+    let key: String = rest
+        .chars()
+        .take_while(|c| !matches!(c, '=' | ']' | '\n' | '\r'))
+        .collect::<String>()
+        .trim()
+        .to_owned();
+    if key.is_empty() {
+        return "duplicate key".to_owned();
+    }
+    let is_header = text[..at].trim_end_matches([' ', '\t']).ends_with('[');
+    let line_start = text[..at].rfind('\n').map_or(0, |newline| newline + 1);
+    let before: Vec<&str> = text[..line_start].lines().collect();
+    // A table header may repeat anywhere above; a key only within the table it is in, so the
+    // search for it walks back to that table's header.
+    let first = before
+        .iter()
+        .enumerate()
+        .rev()
+        .take_while(|(_, line)| is_header || !line.trim_start().starts_with('['))
+        .filter_map(|(number, line)| {
+            let line = line.trim();
+            let same = if is_header {
+                line.starts_with('[') && line.trim_start_matches('[').trim_end_matches(']').trim() == key
+            } else {
+                line.strip_prefix(key.as_str())
+                    .is_some_and(|after| after.trim_start().starts_with('='))
+            };
+            same.then_some(number + 1)
+        })
+        .last();
+    let what = if is_header { "table" } else { "key" };
+    match first {
+        Some(line) => format!("duplicate {what} `{key}`: already given on line {line} (each may appear once)"),
+        None => format!("duplicate {what} `{key}` (each may appear once)"),
+    }
 }
 
 /// What every reader needs to know about the file being read.

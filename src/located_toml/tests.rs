@@ -2,8 +2,8 @@
 
 use std::path::Path;
 
-use super::SourceLocation;
 use super::suggest::{nearest, suggest};
+use super::{SourceLocation, parse};
 
 fn location(text: &str, offset: usize) -> (usize, usize) {
     let l = SourceLocation::from_offset(Path::new("f.toml"), text, offset);
@@ -42,4 +42,22 @@ fn suggestions_are_close_or_absent() {
     );
     assert_eq!(suggest("zzz", &keys, "keys"), "; valid keys: center, radius, material");
     assert_eq!(suggest("zzz", &[], "materials"), "; valid materials: (none)");
+}
+
+#[test]
+fn duplicate_keys_and_tables_name_the_key_and_where_it_was_first_given() {
+    let message = |text: &str| parse(text, Path::new("c.toml")).unwrap_err().to_string();
+    assert_eq!(
+        message("[render]\nbounces = 1\nshadows = true\nbounces = 2\n"),
+        "c.toml:4:1: invalid TOML: duplicate key `bounces`: already given on line 2 (each may appear once)"
+    );
+    assert_eq!(
+        message("[render]\nbounces = 1\n[camera]\nfov = 30\n[render]\nseed = 2\n"),
+        "c.toml:5:2: invalid TOML: duplicate table `render`: already given on line 1 (each may appear once)"
+    );
+    // The same key in another table is not the first occurrence.
+    assert_eq!(
+        message("[a]\nx = 1\n[b]\nx = 1\nx = 2\n"),
+        "c.toml:5:1: invalid TOML: duplicate key `x`: already given on line 4 (each may appear once)"
+    );
 }

@@ -3,10 +3,12 @@
 
 use rayon::prelude::*;
 
+use super::faults;
 use super::integrator::Whitted;
 use super::real::{Color, Real, Vec2, Vec3, to_f32};
 use super::sampler::Sampler;
 use super::scene::{Intersection, Scene};
+use crate::fault::{FaultPolicy, FaultSet, NoFaults};
 use crate::film::Film;
 use crate::options::{Filter, RenderOptions};
 use crate::progress::Progress;
@@ -22,26 +24,43 @@ const GAUSSIAN_WEIGHTS: [Real; 3] = [0.25, 0.5, 0.25];
 
 /// Renders the scene without counting anything.
 pub fn render(scene: &Scene, options: &RenderOptions, progress: &dyn Progress) -> Film {
-    render_counted::<NoCount>(scene, options, progress).0
+    render_counted::<NoCount, _>(scene, options, NoFaults, progress).0
 }
 
 /// [`render`], also counting every ray traced, by kind (for `--stats`). The film is the same.
 pub fn render_counting_rays(scene: &Scene, options: &RenderOptions, progress: &dyn Progress) -> (Film, RayCounts) {
-    render_counted::<RayCounts>(scene, options, progress)
+    render_counted::<RayCounts, _>(scene, options, NoFaults, progress)
+}
+
+/// [`render`] as a program with the integrator's mistakes of `faults` would (the catalogue's
+/// [`crate::fault::Injection::Integrator`] faults; the others act on the case, the options or
+/// the PNGs, outside the renderer). Without such a fault this is [`render`].
+pub fn render_with_faults(scene: &Scene, options: &RenderOptions, faults: FaultSet, progress: &dyn Progress) -> Film {
+    if faults.checks_integrator() {
+        render_counted::<NoCount, _>(scene, options, faults, progress).0
+    } else {
+        render(scene, options, progress)
+    }
 }
 
 /// The render loop. Every pixel counts its rays into a [`RayCounts`] of its own, the same code
 /// whatever `C` is, and each band adds its pixels' counts into a `C`; the bands' `C`s are merged
 /// once they finish. With [`NoCount`] the adding compiles away. The film does not depend on `C`.
 ///
-/// Private, so that its only two copies are those above, compiled in this crate: a copy
+/// Private, so that its only copies are those above, compiled in this crate: a copy
 /// instantiated in another crate (a benchmark, say) would be optimised differently from the one
-/// the command line runs.
-fn render_counted<C: RayCounter>(scene: &Scene, options: &RenderOptions, progress: &dyn Progress) -> (Film, C) {
+/// the command line runs. `F` is [`NoFaults`] for every render but a diagnosis's.
+fn render_counted<C: RayCounter, F: FaultPolicy>(
+    scene: &Scene,
+    options: &RenderOptions,
+    faults: F,
+    progress: &dyn Progress,
+) -> (Film, C) {
     let mut film = Film::new(options.trace.width, options.trace.height);
     let pixels = PixelRenderer {
         scene,
-        integrator: Whitted::new(scene, options.trace.bounces, options.trace.shadows, options.spawn),
+        integrator: Whitted::with_faults(scene, options.trace.bounces, options.trace.shadows, options.spawn, faults),
+        faults,
         sampler: Sampler::new(options.trace.samples, options.trace.seed),
         options,
     };
@@ -77,14 +96,15 @@ struct Pixel {
     normal: [f32; 3],
 }
 
-struct PixelRenderer<'a> {
+struct PixelRenderer<'a, F: FaultPolicy> {
     scene: &'a Scene,
-    integrator: Whitted<'a>,
+    integrator: Whitted<'a, F>,
+    faults: F,
     sampler: Sampler,
     options: &'a RenderOptions,
 }
 
-impl PixelRenderer<'_> {
+impl<F: FaultPolicy> PixelRenderer<'_, F> {
     /// The pixel's colour and AOVs; every ray traced for it is added to `rays`.
     fn pixel(&self, x: u32, y: u32, rays: &mut RayCounts) -> Pixel {
         let (width, height) = (self.options.trace.width, self.options.trace.height);
@@ -132,7 +152,7 @@ impl PixelRenderer<'_> {
         }
         rays.aov += 1;
         let ray = self.scene.camera.ray(centre, self.options.trace.width, self.options.trace.height);
-        self.scene.geometry.intersect(&ray)
+        faults::intersect(self.scene, &ray, self.faults)
     }
 }
 

@@ -64,6 +64,7 @@ pub fn build_scene_measured(case: &Case) -> Result<(Scene, BuildStats), BuildErr
             Profile::Native => NormalSource::FromFileOrAveraged,
             Profile::Mit6837 => NormalSource::Averaged,
         },
+        written_plane_normals: case.render.profile == Profile::Mit6837,
         default_material,
         meshes: HashMap::new(),
         mesh_stats: Vec::new(),
@@ -72,7 +73,7 @@ pub fn build_scene_measured(case: &Case) -> Result<(Scene, BuildStats), BuildErr
         uses_default_material: false,
     };
     for spec in &case.objects {
-        builder.add(spec, to_camera_world, None)?;
+        builder.add(spec, to_camera_world, None, false)?;
     }
     if builder.uses_default_material {
         materials.push(Material::default());
@@ -112,6 +113,10 @@ fn light(spec: &LightSpec, eye: DVec3) -> Light {
 
 struct Builder {
     normals: NormalSource,
+    /// The course's reference renderer shades a plane outside any Transform with its normal as
+    /// written (not normalised: `normal 0 2 0` doubles the diffuse term); a Transform
+    /// normalises the normals it hands back.
+    written_plane_normals: bool,
     default_material: u32,
     meshes: HashMap<PathBuf, Arc<Mesh>>,
     mesh_stats: Vec<MeshStats>,
@@ -121,8 +126,17 @@ struct Builder {
 }
 
 impl Builder {
-    /// `parent` is the composed transform of the enclosing groups, `None` for the identity.
-    fn add(&mut self, spec: &ObjectSpec, parent: Option<DMat4>, inherited: Option<u32>) -> Result<(), BuildError> {
+    /// `parent` is the composed transform of the enclosing groups, `None` for the identity;
+    /// `transformed` whether any of them has a transform of its own (the camera-world move is
+    /// not one).
+    fn add(
+        &mut self,
+        spec: &ObjectSpec,
+        parent: Option<DMat4>,
+        inherited: Option<u32>,
+        transformed: bool,
+    ) -> Result<(), BuildError> {
+        let transformed = transformed || !spec.transform.is_empty();
         let material = spec.material.map(|m| m as u32).or(inherited);
         let matrix = match (parent, spec.transform.is_empty()) {
             (parent, true) => parent,
@@ -132,7 +146,7 @@ impl Builder {
         let transform_error = |source| BuildError::Transform { location: spec.location.clone(), source };
         if let ShapeSpec::Group { objects } = &spec.shape {
             for child in objects {
-                self.add(child, matrix, material)?;
+                self.add(child, matrix, material, transformed)?;
             }
             return Ok(());
         }
@@ -143,7 +157,10 @@ impl Builder {
         match &spec.shape {
             ShapeSpec::Group { .. } => unreachable!("groups returned above"),
             ShapeSpec::Plane { normal, offset } => {
-                let plane = transformed_plane(DVec3::from(*normal), *offset, matrix).map_err(transform_error)?;
+                let mut plane = transformed_plane(DVec3::from(*normal), *offset, matrix).map_err(transform_error)?;
+                if self.written_plane_normals && !transformed {
+                    plane.shading_normal = plane.normal * real(DVec3::from(*normal).length());
+                }
                 self.planes.push((plane, material));
             }
             ShapeSpec::Triangle { vertices, normals } => {
@@ -217,8 +234,18 @@ fn transformed_triangle(
 ) -> Result<Triangle, TransformError> {
     let matrix = matrix.unwrap_or(DMat4::IDENTITY);
     let inverse_transpose = inverse_linear(matrix)?.transpose();
-    let vertices = vertices.map(|v| vec3(matrix.transform_point3(DVec3::from(v)).to_array()));
-    let normals = normals.map(|ns| ns.map(|n| vec3((inverse_transpose * DVec3::from(n)).normalize_or_zero().to_array())));
+    let mut vertices = vertices.map(|v| vec3(matrix.transform_point3(DVec3::from(v)).to_array()));
+    let mut normals =
+        normals.map(|ns| ns.map(|n| vec3((inverse_transpose * DVec3::from(n)).normalize_or_zero().to_array())));
+    // A mirroring matrix reverses the winding, and with it the face normal taken from the moved
+    // vertices; swapping two vertices keeps the face normal the inverse transpose's, as for an
+    // instanced mesh and in the course's reference renderer.
+    if glam::DMat3::from_mat4(matrix).determinant() < 0.0 {
+        vertices.swap(1, 2);
+        if let Some(normals) = &mut normals {
+            normals.swap(1, 2);
+        }
+    }
     Ok(Triangle { vertices, normals })
 }
 

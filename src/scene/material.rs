@@ -23,17 +23,22 @@ impl Material {
         self.specular != Color::ZERO
     }
 
-    /// Diffuse plus specular light from one light: `clamp(L·N)·I·kd + clamp(R·V)^s·I·ks` with
-    /// `R = 2(L·N)N − L`. The cosine is clamped before `powf`, so any shininess (0 included,
-    /// where `0^0 = 1`) gives a finite result.
+    /// Diffuse plus specular light from one light: `max(L·N, 0)·I·kd + max(R·V, 0)^s·I·ks` with
+    /// `R = 2(L·N)N − L`. Negative cosines are clamped before `powf`, so any shininess (0
+    /// included, where `0^0 = 1`) gives a finite result. With a unit normal both cosines are at
+    /// most 1; the course's reference renderer clamps only below, which shows on its planes,
+    /// whose normals keep the length they were written with.
     pub fn shade(&self, normal: Vec3, to_light: Vec3, to_eye: Vec3, intensity: Color) -> Color {
         let cos_light = to_light.dot(normal);
-        let diffuse = cos_light.clamp(0.0, 1.0) * self.diffuse;
-        if !self.reflects() {
+        let diffuse = cos_light.max(0.0) * self.diffuse;
+        let reflected = 2.0 * cos_light * normal - to_light;
+        let cos_view = reflected.dot(to_eye).max(0.0);
+        // Without a specular colour the highlight adds 0·h = 0, so `powf` is skipped, unless
+        // h may overflow (cos_view > 1, only on such a plane): there the reference adds 0·∞ = NaN.
+        if !self.reflects() && cos_view <= 1.0 {
             return diffuse * intensity;
         }
-        let reflected = 2.0 * cos_light * normal - to_light;
-        let highlight = reflected.dot(to_eye).clamp(0.0, 1.0).powf(self.shininess);
+        let highlight = cos_view.powf(self.shininess);
         (diffuse + highlight * self.specular) * intensity
     }
 }

@@ -66,16 +66,16 @@ depth = [6, 14]
     )
 }
 
-fn case() -> Case {
+pub fn case() -> Case {
     load(&scene_path(), &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"))
 }
 
-fn render(case: &Case) -> Film {
+pub fn render(case: &Case) -> Film {
     render_case(case).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Colour, normals and depth as the course binary writes them.
-fn pictures(film: &Film) -> [RgbImage; 3] {
+pub fn pictures(film: &Film) -> [RgbImage; 3] {
     [
         color_image(film, Tonemap::Clamp),
         normals_image(film, Tonemap::Clamp),

@@ -3,26 +3,12 @@
 
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
 use goldray::case::{LoadOptions, load};
 use goldray::options::Filter;
 use serde_json::Value;
 
-fn goldray(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_goldray"))
-        .args(args)
-        .output()
-        .expect("the goldray binary runs")
-}
-
-fn stderr(output: &Output) -> String {
-    String::from_utf8_lossy(&output.stderr).into_owned()
-}
-
-fn shipped_case(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("cases").join(name)
-}
+use crate::util::{goldray, shipped as shipped_case, stderr};
 
 fn read_json(path: &Path) -> Value {
     serde_json::from_slice(&fs::read(path).unwrap()).unwrap_or_else(|e| panic!("{}: {e}", path.display()))

@@ -58,7 +58,8 @@ impl Parser<'_> {
     }
 
     /// Exactly `numLights` lights: the course reads that many and then insists on the `}`.
-    pub(super) fn lights(&mut self) -> Result<Vec<LightSpec>> {
+    /// Returns them with the count, which decides the ambient rule.
+    pub(super) fn lights(&mut self) -> Result<(Vec<LightSpec>, usize)> {
         const KINDS: &[&str] = &["DirectionalLight", "PointLight"];
         self.lex.expect("{", "after `Lights`")?;
         self.lex.expect("numLights", "first in Lights")?;
@@ -76,29 +77,48 @@ impl Parser<'_> {
                     self.lex.expect("}", "closing DirectionalLight")?;
                     LightSpec::Directional { direction, color }
                 }
-                "PointLight" => self.point_light()?,
+                "PointLight" => self.point_light(token)?,
                 "}" => return Err(self.too_few(token, "numLights", count, lights.len(), "light")),
                 _ => return Err(self.unknown(token, "light", KINDS, "lights")),
             });
         }
         self.lex
             .expect("}", &format!("closing Lights after its {count} (numLights) lights"))?;
-        Ok(lights)
+        Ok((lights, count))
     }
 
-    fn point_light(&mut self) -> Result<LightSpec> {
+    /// Fields in any order, each optional and the last of a repeated one winning, as the
+    /// course's loop reads them. `position` and `color` default to zero as there; `falloff`
+    /// defaults to 0 there too, which divides by zero and renders every lit surface black
+    /// (NaN), so here it is required.
+    fn point_light(&mut self, keyword: Token) -> Result<LightSpec> {
+        const FIELDS: &[&str] = &["position", "color", "falloff"];
         self.lex.expect("{", "after `PointLight`")?;
-        self.lex.expect("position", "first in PointLight")?;
-        let position = self.lex.vec3("3 numbers after `position`")?.value;
-        self.lex.expect("color", "after the light's position")?;
-        let color = self.color("color")?;
-        self.lex.expect("falloff", "after the light's color")?;
-        let (falloff, token) = self.lex.number("a number after `falloff`")?;
-        if falloff <= 0.0 {
-            let rule = "must be > 0 (intensity is color / (falloff · d²))";
-            return Err(self.invalid(token, "`falloff`", rule));
+        let (mut position, mut color, mut falloff) = ([0.0; 3], [0.0; 3], None);
+        loop {
+            let token = self.lex.word_for("a PointLight field or `}`")?;
+            match token.text {
+                "}" => break,
+                "position" => position = self.lex.vec3("3 numbers after `position`")?.value,
+                "color" => color = self.color("color")?,
+                "falloff" => {
+                    let (value, token) = self.lex.number("a number after `falloff`")?;
+                    // As a `float`, as the course divides by it: 1e-300 is 0 there.
+                    if value as f32 <= 0.0 {
+                        let rule = "must be > 0 in single precision (intensity is color / (falloff · d²))";
+                        return Err(self.invalid(token, "`falloff`", rule));
+                    }
+                    falloff = Some(value);
+                }
+                _ => return Err(self.unknown(token, "PointLight field", FIELDS, "fields")),
+            }
         }
-        self.lex.expect("}", "closing PointLight")?;
+        let Some(falloff) = falloff else {
+            let message = "this PointLight has no `falloff`: the course would divide by its \
+                           default 0 and render every lit surface black; add e.g. `falloff 0.05` \
+                           (intensity is color / (falloff · d²))";
+            return Err(self.lex.error_at(keyword.start, message));
+        };
         Ok(LightSpec::Point {
             position,
             color,
@@ -106,8 +126,9 @@ impl Parser<'_> {
         })
     }
 
-    /// Appends rather than replaces, because objects already read refer to an earlier block's
-    /// materials by index; `block_materials` keeps what `MaterialIndex` now counts from.
+    /// Appends, as the course does: its material list grows with every block, while
+    /// `numMaterials` is replaced, so `MaterialIndex k` names the k-th material of the whole
+    /// file and must be below the latest block's count.
     pub(super) fn materials(&mut self) -> Result<()> {
         const KINDS: &[&str] = &["Material", "PhongMaterial"];
         self.lex.expect("{", "after `Materials`")?;
@@ -132,7 +153,7 @@ impl Parser<'_> {
             "}",
             &format!("closing Materials after its {count} (numMaterials) materials"),
         )?;
-        self.block_materials = first..self.materials.len();
+        self.material_count = count;
         Ok(())
     }
 

@@ -39,37 +39,135 @@ fn digits(bytes: &[u8]) -> usize {
     bytes.iter().take_while(|b| b.is_ascii_digit()).count()
 }
 
-/// Length of the decimal number `%f` would convert at the start of `s`: sign, digits with an
-/// optional point, and an exponent only when digits follow it.
-fn number_prefix(s: &str) -> usize {
-    let b = s.as_bytes();
-    let mut i = usize::from(matches!(b.first(), Some(b'+' | b'-')));
-    let whole = digits(&b[i..]);
-    i += whole;
-    let mut fraction = 0;
-    if b.get(i) == Some(&b'.') {
-        fraction = digits(&b[i + 1..]);
-        if whole + fraction > 0 {
-            i += 1 + fraction;
-        }
-    }
-    if whole + fraction == 0 {
-        return 0;
-    }
-    if matches!(b.get(i), Some(b'e' | b'E')) {
-        let sign = usize::from(matches!(b.get(i + 1), Some(b'+' | b'-')));
-        let exponent = digits(&b[(i + 1 + sign).min(b.len())..]);
-        if exponent > 0 {
-            i += 1 + sign + exponent;
-        }
-    }
-    i
+/// What `%f` makes of the text at the cursor (glibc's `scanf`, which the course binary uses).
+#[derive(Debug, PartialEq)]
+enum Scanned {
+    /// A number: how many bytes `%f` consumes, and the value.
+    Number(usize, f64),
+    /// `inf`, `infinity` or `nan` (any case, signed), which `%f` reads too.
+    NonFinite(usize),
+    /// Nothing `%f` converts: the course's `readFloat` fails its assert.
+    Nothing,
 }
 
-/// `%f` also reads `inf` and `nan`; they are recognised only to be rejected with a clear reason.
-fn is_non_finite_word(s: &str) -> bool {
-    let unsigned = s.trim_start_matches(['+', '-']).to_ascii_lowercase();
-    unsigned.starts_with("inf") || unsigned.starts_with("nan")
+fn hex_digits(bytes: &[u8]) -> usize {
+    bytes.iter().take_while(|b| b.is_ascii_hexdigit()).count()
+}
+
+/// `%f` at the start of `s`, byte for byte as glibc reads it: an optional sign, then a decimal
+/// number (`4`, `4.`, `.4`), a hexadecimal one (`0x1.8p1`) or `inf`/`nan`. An exponent marker
+/// is consumed even when no digits follow it (`1e}` reads as 1 and leaves `}`), while a
+/// decimal point needs a digit on one side. What follows the number is left for the next read.
+fn scan_float(s: &str) -> Scanned {
+    let b = s.as_bytes();
+    let sign = usize::from(matches!(b.first(), Some(b'+' | b'-')));
+    let negative = b.first() == Some(&b'-');
+    let rest = &b[sign..];
+    let lower = |n: usize| rest.get(..n).map(<[u8]>::to_ascii_lowercase);
+    if lower(8).as_deref() == Some(b"infinity") {
+        return Scanned::NonFinite(sign + 8);
+    }
+    if matches!(lower(3).as_deref(), Some(b"inf" | b"nan")) {
+        return Scanned::NonFinite(sign + 3);
+    }
+    let (len, magnitude) = if lower(2).as_deref() == Some(b"0x") {
+        match scan_hex(&rest[2..]) {
+            Some((len, value)) => (2 + len, value),
+            None => return Scanned::Nothing,
+        }
+    } else {
+        match scan_decimal(rest) {
+            Some(scanned) => scanned,
+            None => return Scanned::Nothing,
+        }
+    };
+    Scanned::Number(sign + len, if negative { -magnitude } else { magnitude })
+}
+
+/// A decimal number without its sign; `None` when there is no digit before the exponent.
+fn scan_decimal(b: &[u8]) -> Option<(usize, f64)> {
+    let whole = digits(b);
+    let mut len = whole;
+    let mut fraction = 0;
+    if b.get(len) == Some(&b'.') {
+        fraction = digits(&b[len + 1..]);
+        len += 1 + fraction;
+    }
+    if whole + fraction == 0 {
+        return None;
+    }
+    let mantissa_len = len;
+    let mut exponent_len = 0;
+    if matches!(b.get(len), Some(b'e' | b'E')) {
+        let sign = usize::from(matches!(b.get(len + 1), Some(b'+' | b'-')));
+        exponent_len = digits(&b[len + 1 + sign..]);
+        len += 1 + sign + exponent_len;
+    }
+    // Without exponent digits, the marker (and its sign) is consumed but means nothing.
+    let number = if exponent_len > 0 {
+        &b[..len]
+    } else {
+        &b[..mantissa_len]
+    };
+    let value = std::str::from_utf8(number).ok()?.parse::<f64>().ok()?;
+    Some((len, value))
+}
+
+/// The digits of a hexadecimal number after its `0x`: hex digits with an optional point, then
+/// an optional binary exponent `p±d`. glibc takes `0x.` alone as zero (and then leaves a `p`).
+fn scan_hex(b: &[u8]) -> Option<(usize, f64)> {
+    let whole = hex_digits(b);
+    let mut len = whole;
+    let mut fraction = 0;
+    let point = b.get(len) == Some(&b'.');
+    if point {
+        fraction = hex_digits(&b[len + 1..]);
+        len += 1 + fraction;
+    }
+    if whole + fraction == 0 {
+        return point.then_some((len, 0.0));
+    }
+    // Keep the first 15 significant digits (60 bits, more than an f64 holds); each dropped
+    // digit of the whole part scales by 16, a dropped fraction digit only loses precision.
+    let mut mantissa: u64 = 0;
+    let mut scale: i64 = 0;
+    for (i, digit) in b[..len].iter().filter(|d| **d != b'.').enumerate() {
+        let value = u64::from((*digit as char).to_digit(16).unwrap_or(0));
+        if mantissa < 1 << 56 {
+            mantissa = mantissa * 16 + value;
+            if i >= whole {
+                scale -= 4;
+            }
+        } else if i < whole {
+            scale += 4;
+        }
+    }
+    if matches!(b.get(len), Some(b'p' | b'P')) {
+        let sign = usize::from(matches!(b.get(len + 1), Some(b'+' | b'-')));
+        let count = digits(&b[len + 1 + sign..]);
+        let written = &b[len + 1 + sign..len + 1 + sign + count];
+        // Saturated: any exponent past ±100,000 is already far beyond zero or infinity.
+        let exponent = written
+            .iter()
+            .fold(0i64, |e, d| (e * 10 + i64::from(d - b'0')).min(100_000));
+        scale += if b.get(len + 1) == Some(&b'-') {
+            -exponent
+        } else {
+            exponent
+        };
+        len += 1 + sign + count;
+    }
+    Some((len, scale_by_power_of_two(mantissa as f64, scale)))
+}
+
+/// `value · 2^exponent` without the intermediate overflow or underflow of one big power.
+fn scale_by_power_of_two(mut value: f64, mut exponent: i64) -> f64 {
+    while exponent != 0 && value != 0.0 && value.is_finite() {
+        let step = exponent.clamp(-1000, 1000);
+        value *= 2f64.powi(step as i32);
+        exponent -= step;
+    }
+    value
 }
 
 impl<'a> Lexer<'a> {
@@ -124,7 +222,8 @@ impl<'a> Lexer<'a> {
             Some(token) => (token.start, quote(token.text)),
             None => (self.text.len(), "the end of the file".to_owned()),
         };
-        self.error_at(offset, format!("expected {wanted}, found {found}"))
+        let hint = self.peek().map_or("", |token| comment_hint(token.text));
+        self.error_at(offset, format!("expected {wanted}, found {found}{hint}"))
     }
 
     /// Consumes `word`, which must come next; `context` completes "expected `word` …".
@@ -142,29 +241,36 @@ impl<'a> Lexer<'a> {
         }
     }
 
-    /// A finite number; `wanted` completes "expected …", e.g. "a number after `radius`".
+    /// A number as `%f` reads it; `wanted` completes "expected …", e.g. "a number after
+    /// `radius`". It must be finite as the course's `float`: `nan`, `inf` and values beyond
+    /// single precision read as non-finite there and make no picture.
     pub fn number(&mut self, wanted: &str) -> Result<(f64, Token<'a>)> {
         let Some(word) = self.peek() else {
             return Err(self.unexpected(wanted));
         };
-        let len = number_prefix(word.text);
-        if len == 0 {
-            return Err(if is_non_finite_word(word.text) {
-                self.non_finite(word)
-            } else {
-                self.unexpected(wanted)
-            });
-        }
+        let (len, value) = match scan_float(word.text) {
+            Scanned::Number(len, value) => (len, Some(value)),
+            Scanned::NonFinite(len) => (len, None),
+            Scanned::Nothing => return Err(self.unexpected(wanted)),
+        };
         let token = Token {
             text: &word.text[..len],
             start: word.start,
         };
-        match token.text.parse::<f64>() {
-            Ok(value) if value.is_finite() => {
+        match value {
+            Some(value) if (value as f32).is_finite() => {
                 self.pos += len;
                 Ok((value, token))
             }
-            _ => Err(self.non_finite(token)),
+            Some(_) => Err(self.error_at(
+                token.start,
+                format!(
+                    "{} is beyond single precision: the course reads numbers as `float`, where it \
+                     is infinite (the largest is about 3.4e38)",
+                    quote(token.text)
+                ),
+            )),
+            None => Err(self.non_finite(token)),
         }
     }
 
@@ -187,7 +293,7 @@ impl<'a> Lexer<'a> {
         })
     }
 
-    /// A non-negative whole number after `label` (`%d`), for counts and indices.
+    /// A non-negative whole number after `label`, as `%d` reads it, for counts and indices.
     pub fn count(&mut self, label: &str) -> Result<(usize, Token<'a>)> {
         let wanted = format!("a whole number after `{label}`");
         let Some(word) = self.peek() else {
@@ -203,7 +309,14 @@ impl<'a> Lexer<'a> {
             text: &word.text[..len],
             start: word.start,
         };
-        let value = token.text.parse::<i64>().ok().filter(|v| *v >= 0);
+        // The course reads counts with `%d` into an `int`: a larger one wraps around, and a
+        // negative one silently means none (and `numLights -1` keeps the ambient light as
+        // written, where `numLights 0` makes it white). Both are refused.
+        let value = token
+            .text
+            .parse::<i64>()
+            .ok()
+            .filter(|v| *v >= 0 && *v <= i64::from(i32::MAX));
         match value.and_then(|v| usize::try_from(v).ok()) {
             Some(v) => {
                 self.pos += len;
@@ -212,7 +325,8 @@ impl<'a> Lexer<'a> {
             None => Err(self.error_at(
                 token.start,
                 format!(
-                    "`{label}` must be a count ≥ 0 that fits in 64 bits, found `{}`",
+                    "`{label}` must be a whole number from 0 to {} (a C `int`), found `{}`",
+                    i32::MAX,
                     token.text
                 ),
             )),
@@ -224,6 +338,16 @@ impl<'a> Lexer<'a> {
         self.text
             .get(first.start..last.start + last.text.len())
             .unwrap_or(first.text)
+    }
+}
+
+/// Said when a word looks like the start of a comment, which the course's format does not have:
+/// its binary reads `#` or `//` as a word and stops ("Unknown token", or an assert).
+pub(super) fn comment_hint(word: &str) -> &'static str {
+    if word.starts_with('#') || word.starts_with("//") {
+        " (the course's scene format has no comments)"
+    } else {
+        ""
     }
 }
 
@@ -242,24 +366,66 @@ pub(super) fn quote(text: &str) -> String {
 mod tests {
     use super::*;
 
+    /// Each row is what glibc's `fscanf("%f")` consumed and converted, recorded with a C
+    /// program on glibc 2.36 (the course binary links the system's glibc).
     #[test]
-    fn numbers_follow_scanf() {
-        for (text, len) in [
-            ("20}", 2),
-            ("-.16", 4),
-            (".4", 2),
-            ("+3.", 3),
-            ("1e5}", 3),
-            ("1e}", 1),
-            ("1e+}", 1),
-            ("2.5e-3x", 6),
-            ("-", 0),
-            (".", 0),
-            ("-.e5", 0),
-            ("}", 0),
-            ("1.2.3", 3),
+    fn numbers_follow_glibc_scanf() {
+        use Scanned::{NonFinite, Nothing, Number};
+        for (text, expected) in [
+            ("20}", Number(2, 20.0)),
+            ("-.16", Number(4, -0.16)),
+            (".4", Number(2, 0.4)),
+            ("4.", Number(2, 4.0)),
+            ("+3.", Number(3, 3.0)),
+            ("-0", Number(2, -0.0)),
+            ("00.5", Number(4, 0.5)),
+            ("1e-3", Number(4, 1e-3)),
+            ("1e0010", Number(6, 1e10)),
+            ("1.e5", Number(4, 1e5)),
+            ("1e5}", Number(3, 1e5)),
+            ("1e5e5", Number(3, 1e5)),
+            ("2.5e-3x", Number(6, 2.5e-3)),
+            ("1.2.3", Number(3, 1.2)),
+            ("1,5", Number(1, 1.0)),
+            // An exponent marker without digits is consumed and ignored.
+            ("1e}", Number(2, 1.0)),
+            ("1e+}", Number(3, 1.0)),
+            ("1E-", Number(3, 1.0)),
+            ("0e", Number(2, 0.0)),
+            ("1ex", Number(2, 1.0)),
+            // Hexadecimal, as C99 and glibc read it.
+            ("0x1.8p1", Number(7, 3.0)),
+            ("-0x1p3}", Number(6, -8.0)),
+            ("0X.8", Number(4, 0.5)),
+            ("0x1e3", Number(5, 483.0)),
+            ("0xABCDEF", Number(8, 11_259_375.0)),
+            ("0x1P-2", Number(6, 0.25)),
+            ("0x1p}", Number(4, 1.0)),
+            ("0x1p+}", Number(5, 1.0)),
+            ("0x1.", Number(4, 1.0)),
+            ("0x.8p", Number(5, 0.5)),
+            ("0x.}", Number(3, 0.0)),
+            ("0x.p1", Number(3, 0.0)),
+            ("0x1ffffffffffffffffffffp0", Number(25, 2.417_851_639_229_258_3e24)),
+            ("inf", NonFinite(3)),
+            ("-INF", NonFinite(4)),
+            ("infinity", NonFinite(8)),
+            ("nan(123)", NonFinite(3)),
+            ("NaN", NonFinite(3)),
+            ("-", Nothing),
+            ("+", Nothing),
+            (".", Nothing),
+            ("+-1", Nothing),
+            ("-.e5", Nothing),
+            (".e5", Nothing),
+            ("0x", Nothing),
+            ("0x}", Nothing),
+            ("0xg", Nothing),
+            ("0xp1", Nothing),
+            ("in", Nothing),
+            ("}", Nothing),
         ] {
-            assert_eq!(number_prefix(text), len, "{text}");
+            assert_eq!(scan_float(text), expected, "{text}");
         }
     }
 
@@ -275,7 +441,7 @@ mod tests {
 
     #[test]
     fn non_finite_and_missing_numbers_are_errors() {
-        for text in ["nan", "-inf", "1e999", "Infinity"] {
+        for text in ["nan", "-inf", "1e999", "Infinity", "1e39", "-0x1p128"] {
             let message = Lexer::new(Path::new("s.txt"), text)
                 .number("a number")
                 .unwrap_err()
@@ -297,6 +463,10 @@ mod tests {
         let count = |text: &str| Lexer::new(Path::new("s.txt"), text).count("numObjects").map(|(n, _)| n);
         assert_eq!(count("3}").unwrap(), 3);
         assert!(count("2.5").is_err());
+        assert_eq!(count("+3").unwrap(), 3);
+        assert_eq!(count("-0").unwrap(), 0);
+        assert_eq!(count("2147483647").unwrap(), 2_147_483_647);
+        assert!(count("2147483648").is_err(), "wraps around in a C int");
         assert!(count("-1").is_err());
         assert!(count("99999999999999999999").is_err());
         assert!(count("x").is_err());

@@ -3,38 +3,44 @@
 //! A course `Transform { ops… object }` wraps one object; here it becomes that object with the
 //! ops in front of its own, which is the same matrix because the outer transform is applied last.
 
-use super::Parser;
 use super::lexer::{Result, Token};
+use super::{Parser, usable_in_single_precision};
 use crate::case::objects::{file_problem, singularity};
 use crate::case::spec::{ObjectSpec, ShapeSpec, TransformOp};
-use crate::case::value::has_usable_length;
 
-const GROUP_WORDS: &[&str] = &[
-    "Group",
-    "Sphere",
-    "Plane",
-    "Triangle",
-    "TriangleMesh",
-    "Transform",
-    "MaterialIndex",
-];
+/// What a group or a transform may hold.
+const OBJECT_WORDS: [&str; 6] = ["Group", "Sphere", "Plane", "Triangle", "TriangleMesh", "Transform"];
+/// What may come in a group: an object, or the material of what follows.
+const GROUP_WORDS: [&str; 7] = concat(OBJECT_WORDS, ["MaterialIndex"]);
+/// What may come in a transform: its ops, then its object.
+const TRANSFORM_WORDS: [&str; 14] = concat(
+    [
+        "Scale",
+        "UniformScale",
+        "Translate",
+        "XRotate",
+        "YRotate",
+        "ZRotate",
+        "Rotate",
+        "Matrix4f",
+    ],
+    OBJECT_WORDS,
+);
 
-const TRANSFORM_WORDS: &[&str] = &[
-    "Scale",
-    "UniformScale",
-    "Translate",
-    "XRotate",
-    "YRotate",
-    "ZRotate",
-    "Rotate",
-    "Matrix4f",
-    "Group",
-    "Sphere",
-    "Plane",
-    "Triangle",
-    "TriangleMesh",
-    "Transform",
-];
+/// `first` then `second`, for keyword lists that share a part (`N` must be `A + B`).
+const fn concat<const A: usize, const B: usize, const N: usize>(
+    first: [&'static str; A],
+    second: [&'static str; B],
+) -> [&'static str; N] {
+    assert!(A + B == N, "the lengths must add up");
+    let mut all = [""; N];
+    let mut i = 0;
+    while i < N {
+        all[i] = if i < A { first[i] } else { second[i - A] };
+        i += 1;
+    }
+    all
+}
 
 /// Far deeper than any real scene, and shallow enough that neither this recursive parser nor
 /// the TOML written by `case_to_toml` (toml's own limit is 80 levels) can run out of depth.
@@ -55,7 +61,7 @@ impl<'a> Parser<'a> {
                     let given = objects.len();
                     return Err(self.too_few(token, "numObjects", count, given, "object"));
                 }
-                _ => objects.push(self.object(token, "object", GROUP_WORDS, "objects")?),
+                _ => objects.push(self.object(token, "object", &GROUP_WORDS, "objects")?),
             }
         }
         self.lex
@@ -63,22 +69,22 @@ impl<'a> Parser<'a> {
         Ok(objects)
     }
 
-    /// `MaterialIndex k` names the k-th material of the latest Materials block, as in the course.
+    /// `MaterialIndex k` names the k-th material read so far, counting every Materials block,
+    /// and must be below the latest block's `numMaterials`: the course asserts exactly that.
     fn material_index(&mut self) -> Result<()> {
         let (k, token) = self.lex.count("MaterialIndex")?;
-        let block = self.block_materials.clone();
-        if k < block.len() {
-            self.current_material = Some(block.start + k);
+        if k < self.material_count {
+            self.current_material = Some(k);
             return Ok(());
         }
-        let message = match block.len() {
+        let message = match self.material_count {
             0 => format!(
                 "`MaterialIndex {k}` refers to no material: no materials are defined before it \
-                 (a Materials block must come before the Group)"
+                 (a Materials block with numMaterials ≥ 1 must come before the Group)"
             ),
             n => format!(
-                "`MaterialIndex {k}` is out of range: numMaterials is {n}, so indices go from 0 \
-                 to {}",
+                "`MaterialIndex {k}` is out of range: the latest Materials block has numMaterials \
+                 {n}, so indices go from 0 to {}",
                 n - 1
             ),
         };
@@ -101,7 +107,19 @@ impl<'a> Parser<'a> {
         };
         let material = match shape {
             ShapeSpec::Group { .. } => None,
-            _ => self.current_material,
+            // The course asserts a material for a sphere, plane or triangle, and dereferences
+            // a mesh's null material as soon as a ray hits the mesh.
+            _ => match self.current_material {
+                Some(material) => Some(material),
+                None => {
+                    let message = format!(
+                        "this {} has no material: put `MaterialIndex k` before it (the course \
+                         stops on a shape without one)",
+                        token.text
+                    );
+                    return Err(self.lex.error_at(token.start, message));
+                }
+            },
         };
         Ok(ObjectSpec {
             shape,
@@ -127,12 +145,14 @@ impl<'a> Parser<'a> {
         self.lex.expect("center", "first in Sphere")?;
         let center = self.lex.vec3("3 numbers after `center`")?.value;
         self.lex.expect("radius", "after the sphere's center")?;
-        let (radius, token) = self.lex.number("a number after `radius`")?;
-        if radius < 0.0 {
-            return Err(self.invalid(token, "`radius`", "must be ≥ 0"));
-        }
+        let (radius, _) = self.lex.number("a number after `radius`")?;
         self.lex.expect("}", "closing Sphere")?;
-        Ok(ShapeSpec::Sphere { center, radius })
+        // The course's sphere test uses only r² and normalises `p − center`, so a negative
+        // radius draws the sphere of radius |r|, normals and all.
+        Ok(ShapeSpec::Sphere {
+            center,
+            radius: radius.abs(),
+        })
     }
 
     fn plane(&mut self) -> Result<ShapeSpec> {
@@ -171,6 +191,10 @@ impl<'a> Parser<'a> {
         self.lex.expect("{", "after `TriangleMesh`")?;
         self.lex.expect("obj_file", "first in TriangleMesh")?;
         let written = self.lex.word_for("a file name after `obj_file`")?;
+        if !written.text.ends_with(".obj") {
+            let rule = "must name a file ending in `.obj` (the course asserts that extension)";
+            return Err(self.invalid(written, "`obj_file`", rule));
+        }
         let obj = self.dir.join(written.text);
         if let Some(problem) = file_problem(&obj) {
             let message = format!("`obj_file {}` resolves to {}, {problem}", written.text, obj.display());
@@ -206,7 +230,7 @@ impl<'a> Parser<'a> {
                     return Err(self.lex.error_at(token.start, message));
                 }
                 _ => {
-                    break self.object(token, "transform op or object", TRANSFORM_WORDS, "ops and objects")?;
+                    break self.object(token, "transform op or object", &TRANSFORM_WORDS, "ops and objects")?;
                 }
             };
             ops.push(op);
@@ -231,7 +255,7 @@ impl<'a> Parser<'a> {
     fn rotate(&mut self) -> Result<TransformOp> {
         self.lex.expect("{", "after `Rotate`")?;
         let axis = self.lex.vec3("3 numbers (the axis) after `Rotate {`")?;
-        if !has_usable_length(axis.value) {
+        if !usable_in_single_precision(axis.value) {
             let rule = "must have a nonzero, finite length";
             return Err(self.invalid_vec(&axis, "the rotation axis", rule));
         }

@@ -136,11 +136,7 @@ impl Prim {
 
     #[inline(always)]
     fn centroid4(&self) -> [Real; 4] {
-        let mut centroid = [0.0; 4];
-        for axis in 0..4 {
-            centroid[axis] = self.min[axis] * 0.5 + self.max[axis] * 0.5;
-        }
-        centroid
+        std::array::from_fn(|axis| self.min[axis] * 0.5 + self.max[axis] * 0.5)
     }
 }
 
@@ -233,6 +229,9 @@ struct Node<'a> {
 
 /// How a node was decided; for a split, its primitives have already been partitioned at `mid`
 /// and the children's extents are known.
+// A plan lives for one node on the stack, never in a collection: boxing the split would cost an
+// allocation per node for nothing.
+#[allow(clippy::large_enum_variant)]
 enum Plan {
     Leaf,
     Split { mid: usize, below: Extent, above: Extent },
@@ -418,13 +417,13 @@ impl Binned {
         }
         let (mut below_count, mut below_box) = (0, Bounds::EMPTY);
         let mut best: Option<(usize, Real)> = None;
-        for split in 0..BIN_COUNT - 1 {
+        for (split, &above) in above_cost.iter().enumerate().take(BIN_COUNT - 1) {
             below_count += self.counts[split];
             below_box = below_box.union(&self.boxes[split]);
             if below_count == 0 || below_count == count {
                 continue;
             }
-            let split_cost = cost.tests(below_count) * below_box.area() + above_cost[split];
+            let split_cost = cost.tests(below_count) * below_box.area() + above;
             if best.is_none_or(|(_, best_cost)| split_cost < best_cost) {
                 best = Some((split, split_cost));
             }

@@ -1,0 +1,172 @@
+//! The pictures of one rubric render as faulty programs would draw them, rendered once per fault
+//! set and kept beside the golden renders: `CACHE/faults/KEY/SET/PICTURE.png`, where `KEY` is the
+//! golden's cache key (which already names the renderer build, so a stale entry cannot match),
+//! `SET` the fault set as written (`no-shadows+gamma-applied=2.2`) and `PICTURE` `color`,
+//! `normals` or `depth-MIN-MAX`. A set whose faults all act on the PNGs is quantised from the
+//! golden film and never rendered nor stored.
+
+use std::collections::HashMap;
+use std::fs;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
+
+use image::RgbImage;
+
+use crate::atomic_write::write_file_atomic;
+use crate::case::Case;
+use crate::fault::FaultSet;
+use crate::film::{Film, Picture, Tonemap, encode_png, picture_with_faults};
+use crate::pipeline::FaultRenderer;
+
+/// How many rendered films are kept for pairing with PNG faults.
+const KEPT_FILMS: usize = 6;
+
+/// A picture's part of a cache file name.
+pub fn picture_name(picture: Picture) -> String {
+    match picture {
+        Picture::Color => "color".to_owned(),
+        Picture::Normals => "normals".to_owned(),
+        Picture::Depth { min, max } => format!("depth-{min}-{max}"),
+    }
+}
+
+/// Every picture a rubric takes from one render, for any fault set.
+pub struct FaultPictures<'a> {
+    dir: Option<PathBuf>,
+    renderer: FaultRenderer,
+    golden: &'a Film,
+    tonemap: Tonemap,
+    pictures: Vec<Picture>,
+    memo: Mutex<HashMap<String, Arc<Vec<RgbImage>>>>,
+    /// The last films rendered, by render part, so that a render fault paired with PNG faults
+    /// is quantised again rather than rendered again.
+    films: Mutex<Vec<(String, Arc<Film>)>>,
+    /// Fault sets rendered, and read from the cache, in this run.
+    pub rendered: AtomicUsize,
+    pub cached: AtomicUsize,
+}
+
+impl<'a> FaultPictures<'a> {
+    /// `dir`: this render's cache folder, or `None` to cache nothing.
+    pub fn new(dir: Option<PathBuf>, case: &'a Case, golden: &'a Film, pictures: Vec<Picture>) -> Self {
+        FaultPictures {
+            dir,
+            renderer: FaultRenderer::new(case),
+            golden,
+            tonemap: case.render.tonemap,
+            pictures,
+            memo: Mutex::new(HashMap::new()),
+            films: Mutex::new(Vec::new()),
+            rendered: AtomicUsize::new(0),
+            cached: AtomicUsize::new(0),
+        }
+    }
+
+    pub fn pictures(&self) -> &[Picture] {
+        &self.pictures
+    }
+
+    /// The golden pictures, in the order of [`FaultPictures::pictures`].
+    pub fn golden(&self) -> Vec<RgbImage> {
+        self.quantise(self.golden, &FaultSet::NONE)
+    }
+
+    fn quantise(&self, film: &Film, faults: &FaultSet) -> Vec<RgbImage> {
+        self.pictures
+            .iter()
+            .map(|p| picture_with_faults(film, *p, self.tonemap, faults))
+            .collect()
+    }
+
+    /// The pictures a program with `faults` writes, in the order of [`FaultPictures::pictures`]:
+    /// from this run's memory, the cache, the golden film (PNG faults only) or a render.
+    pub fn get(&self, faults: &FaultSet) -> Result<Arc<Vec<RgbImage>>, crate::Error> {
+        let label = faults.to_string();
+        if let Some(found) = self.lock().get(&label) {
+            return Ok(found.clone());
+        }
+        let pictures = Arc::new(if faults.render_part().is_empty() {
+            self.quantise(self.golden, faults)
+        } else if let Some(cached) = self.read_cache(&label) {
+            self.cached.fetch_add(1, Ordering::Relaxed);
+            cached
+        } else {
+            let film = self.film(&faults.render_part())?;
+            let pictures = self.quantise(&film, faults);
+            self.write_cache(&label, &pictures);
+            pictures
+        });
+        self.lock().insert(label, pictures.clone());
+        Ok(pictures)
+    }
+
+    /// The film of a render part, from the last few rendered or rendered now.
+    fn film(&self, render_part: &FaultSet) -> Result<Arc<Film>, crate::Error> {
+        let label = render_part.to_string();
+        let mut films = self.films.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        if let Some((_, film)) = films.iter().find(|(l, _)| *l == label) {
+            return Ok(film.clone());
+        }
+        drop(films);
+        let film = Arc::new(self.renderer.render(render_part)?);
+        self.rendered.fetch_add(1, Ordering::Relaxed);
+        films = self.films.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        if films.len() >= KEPT_FILMS {
+            films.remove(0);
+        }
+        films.push((label, film.clone()));
+        Ok(film)
+    }
+
+    /// The pictures of `faults` when some run already made them, without rendering.
+    pub fn get_if_known(&self, faults: &FaultSet) -> Option<Arc<Vec<RgbImage>>> {
+        self.lock().get(&faults.to_string()).cloned()
+    }
+
+    /// The golden film: PNG faults (a fitted gamma) are quantised from it directly.
+    pub fn golden_film(&self) -> &Film {
+        self.golden
+    }
+
+    pub fn tonemap(&self) -> Tonemap {
+        self.tonemap
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, HashMap<String, Arc<Vec<RgbImage>>>> {
+        self.memo.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+
+    fn entry(&self, label: &str, picture: Picture) -> Option<PathBuf> {
+        Some(
+            self.dir
+                .as_ref()?
+                .join(label)
+                .join(format!("{}.png", picture_name(picture))),
+        )
+    }
+
+    /// Every picture of the set, or nothing: a partial or damaged entry is rendered again.
+    fn read_cache(&self, label: &str) -> Option<Vec<RgbImage>> {
+        let (width, height) = (self.golden.width, self.golden.height);
+        self.pictures
+            .iter()
+            .map(|p| {
+                let bytes = fs::read(self.entry(label, *p)?).ok()?;
+                let picture = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
+                    .ok()?
+                    .into_rgb8();
+                (picture.dimensions() == (width, height)).then_some(picture)
+            })
+            .collect()
+    }
+
+    /// Best effort: a cache that cannot be written costs a render next time, nothing more.
+    fn write_cache(&self, label: &str, pictures: &[RgbImage]) {
+        for (picture, image) in self.pictures.iter().zip(pictures) {
+            if let (Some(path), Ok(bytes)) = (self.entry(label, *picture), encode_png(image)) {
+                let _ = write_file_atomic(&path, &bytes);
+            }
+        }
+    }
+}
