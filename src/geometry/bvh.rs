@@ -505,6 +505,69 @@ pub fn traverse<I: Isa>(nodes: &[BvhNode], ray: &Ray, t_max: Real, visitor: &mut
     }
 }
 
+/// Up to eight boxes side by side, tested at once with the traversal's slab test: a handful of
+/// objects that need no tree.
+#[derive(Clone, Debug)]
+pub struct BoxSet {
+    node: BvhNode,
+    len: usize,
+}
+
+impl BoxSet {
+    /// # Panics
+    /// With more than [`WIDTH`] boxes.
+    pub fn new(bounds: &[Aabb]) -> BoxSet {
+        assert!(bounds.len() <= WIDTH, "a box set holds at most {WIDTH} boxes");
+        let mut node = BvhNode::EMPTY;
+        for (lane, bounds) in bounds.iter().enumerate() {
+            node.set_child(lane, bounds, lane as u32, 1);
+        }
+        BoxSet { node, len: bounds.len() }
+    }
+
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// The boxes the ray enters by `t_limit` (with the traversal's slack), nearest first: `(entry
+    /// distance, box)` for the first `count` entries.
+    ///
+    /// A kernel: compile it only inside one (see `crate::simd`).
+    #[inline(always)]
+    pub fn entered<I: Isa>(&self, ray: &Ray, t_limit: Real) -> ([(Real, usize); WIDTH], usize) {
+        let mut order = [(0.0, 0); WIDTH];
+        if !(ray.origin.is_finite() && ray.direction.is_finite()) {
+            return (order, 0);
+        }
+        let (t_enter, mut hits) = node_hits::<I>(&self.node, &SlabLanes::<I>::new(ray), t_limit);
+        let mut t = [0.0; WIDTH];
+        t_enter.store(&mut t);
+        let mut count = 0;
+        while hits != 0 {
+            let lane = hits.trailing_zeros() as usize;
+            hits &= hits - 1;
+            let mut k = count;
+            while k > 0 && order[k - 1].0 > t[lane] {
+                order[k] = order[k - 1];
+                k -= 1;
+            }
+            order[k] = (t[lane], lane);
+            count += 1;
+        }
+        (order, count)
+    }
+
+    /// Whether a box entered at `t` may hold a hit nearer than `t_limit` (the traversal's pruning).
+    #[inline(always)]
+    pub fn may_hold(t: Real, t_limit: Real) -> bool {
+        t <= t_limit * BOX_SLACK
+    }
+}
+
 /// Rays traversed together by [`traverse_packet`].
 pub const PACKET: usize = 8;
 

@@ -2,7 +2,7 @@
 //! and everything else under a BVH.
 
 use super::geometry::aabb::{Aabb, SlabRay};
-use super::geometry::bvh::{Bvh, LeafCost, Visit, VisitFn, traverse};
+use super::geometry::bvh::{BoxSet, Bvh, LeafCost, Visit, VisitFn, WIDTH, traverse};
 use super::geometry::plane::{PLANE_LANES, Plane, PlanePack, intersect_planes};
 use super::geometry::sphere::{SPHERE_LANES, SphereRay, SpherePack, intersect_spheres};
 use super::geometry::{Ray, SurfaceHit};
@@ -33,6 +33,9 @@ enum Rest {
     /// A lone object, tested directly; behind its world box when it has a transform, since the
     /// box test costs less than moving the ray into the object's space.
     One { object: u32, bounds: Option<Aabb> },
+    /// A handful of objects behind their boxes, tested by one slab test: `objects[lane]` is the
+    /// object of box `lane`.
+    Few { boxes: BoxSet, objects: Vec<u32> },
     /// A tree whose leaves hold positions in `objects`: object indices in the tree's leaf order.
     Tree { bvh: Bvh, objects: Vec<u32> },
 }
@@ -93,6 +96,10 @@ impl Aggregate {
                 let lone = &objects[object as usize];
                 Rest::One { object, bounds: lone.transform.is_some().then(|| lone.bounds()) }
             }
+            few if few.len() <= WIDTH => {
+                let bounds: Vec<Aabb> = few.iter().map(|&index| objects[index as usize].bounds()).collect();
+                Rest::Few { boxes: BoxSet::new(&bounds), objects: others }
+            }
             _ => {
                 let bounds: Vec<Aabb> = others.iter().map(|&index| objects[index as usize].bounds()).collect();
                 let bvh = Bvh::build_for(&bounds, LeafCost::Single);
@@ -115,7 +122,7 @@ impl Aggregate {
     }
 
     /// The tree over the objects that are neither planes nor a handful of plain spheres, when
-    /// there are at least two of them.
+    /// there are more than eight of them (up to eight are tested by one slab test).
     pub fn bvh(&self) -> Option<&Bvh> {
         match &self.rest {
             Rest::Tree { bvh, .. } => Some(bvh),
@@ -188,6 +195,18 @@ impl Aggregate {
                     closest.offer(hit.t(), *object, Found::Object(*object, hit));
                 }
             }
+            Rest::Few { boxes, objects } => {
+                let (entered, count) = boxes.entered::<I>(ray, closest.t);
+                for &(t, lane) in &entered[..count] {
+                    if !BoxSet::may_hold(t, closest.t) {
+                        break;
+                    }
+                    let index = objects[lane];
+                    if let Some(hit) = self.objects[index as usize].intersect(ray, closest.t) {
+                        closest.offer(hit.t(), index, Found::Object(index, hit));
+                    }
+                }
+            }
             Rest::Tree { bvh, objects } => {
                 traverse::<I>(bvh.nodes(), ray, closest.t, &mut VisitFn(|first: u32, count: u32, t_limit: &mut Real| {
                     for &index in &objects[first as usize..(first + count) as usize] {
@@ -232,6 +251,10 @@ impl Aggregate {
             Rest::One { object, bounds } => {
                 bounds.is_none_or(|bounds| bounds.hit_by(&SlabRay::new(ray), t_max))
                     && self.objects[*object as usize].occluded(ray, t_max)
+            }
+            Rest::Few { boxes, objects } => {
+                let (entered, count) = boxes.entered::<I>(ray, t_max);
+                entered[..count].iter().any(|&(_, lane)| self.objects[objects[lane] as usize].occluded(ray, t_max))
             }
             Rest::Tree { bvh, objects } => {
                 let mut blocked = false;
