@@ -51,9 +51,12 @@ fn cases() -> Vec<Case> {
     cases
 }
 
+/// For a fan of rays: each ray's hit alone, the packet's hits, and whether each ray is blocked.
+type FanResults = (Vec<Option<MeshHit>>, Vec<Option<MeshHit>>, Vec<bool>);
+
 /// Rays at a generated blob from all around (coherent fans of eight from one point, and
 /// scattered ones), in packets of eight.
-fn mesh_queries() -> Vec<(Vec<Option<MeshHit>>, Vec<Option<MeshHit>>, Vec<bool>)> {
+fn mesh_queries() -> Vec<FanResults> {
     let (positions, triangles) = blob(5, 3);
     let mesh = Mesh::new(&positions, &triangles, VertexNormals::Averaged).expect("a valid mesh");
     let mut state = 7u64;

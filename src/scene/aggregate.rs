@@ -35,7 +35,7 @@ enum Rest {
     One { object: u32, bounds: Option<Aabb> },
     /// A handful of objects behind their boxes, tested by one slab test: `objects[lane]` is the
     /// object of box `lane`.
-    Few { boxes: BoxSet, objects: Vec<u32> },
+    Few { boxes: Box<BoxSet>, objects: Vec<u32> },
     /// A tree whose leaves hold positions in `objects`: object indices in the tree's leaf order.
     Tree { bvh: Bvh, objects: Vec<u32> },
 }
@@ -98,7 +98,7 @@ impl Aggregate {
             }
             few if few.len() <= WIDTH => {
                 let bounds: Vec<Aabb> = few.iter().map(|&index| objects[index as usize].bounds()).collect();
-                Rest::Few { boxes: BoxSet::new(&bounds), objects: others }
+                Rest::Few { boxes: Box::new(BoxSet::new(&bounds)), objects: others }
             }
             _ => {
                 let bounds: Vec<Aabb> = others.iter().map(|&index| objects[index as usize].bounds()).collect();
