@@ -533,32 +533,47 @@ impl BoxSet {
         self.len == 0
     }
 
-    /// The boxes the ray enters by `t_limit` (with the traversal's slack), nearest first: `(entry
-    /// distance, box)` for the first `count` entries.
+    /// A bit per box the ray enters by `t_limit` (with the traversal's slack), and where it enters
+    /// each (meaningful for those bits).
     ///
     /// A kernel: compile it only inside one (see `crate::simd`).
     #[inline(always)]
-    pub fn entered<I: Isa>(&self, ray: &Ray, t_limit: Real) -> ([(Real, usize); WIDTH], usize) {
-        let mut order = [(0.0, 0); WIDTH];
-        if !(ray.origin.is_finite() && ray.direction.is_finite()) {
-            return (order, 0);
-        }
-        let (t_enter, mut hits) = node_hits::<I>(&self.node, &SlabLanes::<I>::new(ray), t_limit);
+    pub fn entered<I: Isa>(&self, ray: &Ray, t_limit: Real) -> (u32, [Real; WIDTH]) {
         let mut t = [0.0; WIDTH];
+        if !(ray.origin.is_finite() && ray.direction.is_finite()) {
+            return (0, t);
+        }
+        let (t_enter, hits) = node_hits::<I>(&self.node, &SlabLanes::<I>::new(ray), t_limit);
         t_enter.store(&mut t);
+        (hits, t)
+    }
+
+    /// The boxes of `hits` (from [`BoxSet::entered`]) nearest first, in the low bits of keys
+    /// that sort by entry distance; `count` of them.
+    #[inline(always)]
+    pub fn nearest_first(hits: u32, t: &[Real; WIDTH]) -> ([u64; WIDTH], usize) {
+        let mut keys = [0u64; WIDTH];
         let mut count = 0;
-        while hits != 0 {
-            let lane = hits.trailing_zeros() as usize;
-            hits &= hits - 1;
+        let mut remaining = hits;
+        while remaining != 0 {
+            let lane = remaining.trailing_zeros() as usize;
+            remaining &= remaining - 1;
+            let key = sort_key(t[lane], lane);
             let mut k = count;
-            while k > 0 && order[k - 1].0 > t[lane] {
-                order[k] = order[k - 1];
+            while k > 0 && keys[k - 1] > key {
+                keys[k] = keys[k - 1];
                 k -= 1;
             }
-            order[k] = (t[lane], lane);
+            keys[k] = key;
             count += 1;
         }
-        (order, count)
+        (keys, count)
+    }
+
+    /// The box a key of [`BoxSet::nearest_first`] stands for.
+    #[inline(always)]
+    pub fn lane(key: u64) -> usize {
+        key as usize & (WIDTH - 1)
     }
 
     /// Whether a box entered at `t` may hold a hit nearer than `t_limit` (the traversal's pruning).

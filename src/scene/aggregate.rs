@@ -196,14 +196,18 @@ impl Aggregate {
                 }
             }
             Rest::Few { boxes, objects } => {
-                let (entered, count) = boxes.entered::<I>(ray, closest.t);
-                for &(t, lane) in &entered[..count] {
-                    if !BoxSet::may_hold(t, closest.t) {
-                        break;
-                    }
-                    let index = objects[lane];
-                    if let Some(hit) = self.objects[index as usize].intersect(ray, closest.t) {
-                        closest.offer(hit.t(), index, Found::Object(index, hit));
+                let (hits, t) = boxes.entered::<I>(ray, closest.t);
+                if hits != 0 {
+                    let (keys, count) = BoxSet::nearest_first(hits, &t);
+                    for &key in &keys[..count] {
+                        let lane = BoxSet::lane(key);
+                        if !BoxSet::may_hold(t[lane], closest.t) {
+                            break;
+                        }
+                        let index = objects[lane];
+                        if let Some(hit) = self.objects[index as usize].intersect(ray, closest.t) {
+                            closest.offer(hit.t(), index, Found::Object(index, hit));
+                        }
                     }
                 }
             }
@@ -253,8 +257,15 @@ impl Aggregate {
                     && self.objects[*object as usize].occluded(ray, t_max)
             }
             Rest::Few { boxes, objects } => {
-                let (entered, count) = boxes.entered::<I>(ray, t_max);
-                entered[..count].iter().any(|&(_, lane)| self.objects[objects[lane] as usize].occluded(ray, t_max))
+                let (mut hits, _) = boxes.entered::<I>(ray, t_max);
+                while hits != 0 {
+                    let lane = hits.trailing_zeros() as usize;
+                    hits &= hits - 1;
+                    if self.objects[objects[lane] as usize].occluded(ray, t_max) {
+                        return true;
+                    }
+                }
+                false
             }
             Rest::Tree { bvh, objects } => {
                 let mut blocked = false;
