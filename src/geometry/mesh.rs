@@ -8,7 +8,7 @@ use super::huge_page_vec;
 use super::bvh::{Bvh, LeafCost, LeafVisitor, PACKET, PacketLanes, PacketVisitor, Visit, traverse, traverse_packet};
 use super::triangle::{
     PackRay, RayLanes, TriangleHit, TrianglePack, face_normal, intersect_pack, intersect_triangle_rays, lane_hit, normalize,
-    ray_lane_hit, triangle_surface,
+    triangle_surface,
 };
 use super::{Ray, SurfaceHit};
 use super::real::{R8, Real, Vec3};
@@ -321,7 +321,7 @@ impl<I: Isa> PacketVisitor<I> for NearestTriangles<'_, I> {
                         None => true,
                     };
                     if nearer {
-                        let hit = ray_lane_hit(&values, lane);
+                        let hit = lane_hit(&values, lane);
                         t_limit[lane] = t;
                         self.closest[lane] = Some(MeshHit { t, triangle: id, barycentrics: [hit.b0, hit.b1, hit.b2] });
                     }

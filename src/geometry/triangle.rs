@@ -244,9 +244,10 @@ impl<I: Isa> PackHits<I> {
     }
 }
 
-/// Lane `lane` of [`PackHits::lanes`], as [`intersect_triangle`] would report it.
+/// Lane `lane` of [`PackHits::lanes`] or [`RayHits::lanes`], as [`intersect_triangle`] would
+/// report it.
 #[inline(always)]
-pub fn lane_hit(values: &[[Real; 4]; 5], lane: usize) -> TriangleHit {
+pub fn lane_hit<const N: usize>(values: &[[Real; N]; 5], lane: usize) -> TriangleHit {
     let inv_det = values[4][lane];
     TriangleHit { t: values[0][lane], b0: values[1][lane] * inv_det, b1: values[2][lane] * inv_det, b2: values[3][lane] * inv_det }
 }
@@ -381,13 +382,6 @@ impl<I: Isa> RayHits<I> {
         self.inv_det.store(&mut values[4]);
         values
     }
-}
-
-/// Lane `lane` of [`RayHits::lanes`], as [`intersect_triangle`] would report it.
-#[inline(always)]
-pub fn ray_lane_hit(values: &[[Real; 8]; 5], lane: usize) -> TriangleHit {
-    let inv_det = values[4][lane];
-    TriangleHit { t: values[0][lane], b0: values[1][lane] * inv_det, b1: values[2][lane] * inv_det, b2: values[3][lane] * inv_det }
 }
 
 /// Vertex `v` of triangle `triangle` of `pack`, relative to each ray's origin, permuted and

@@ -326,16 +326,19 @@ pub(super) fn diagnose_class(
         let golden_pictures = store.golden();
         // Where the golden primary rays hit nothing (the background shows).
         let misses: Vec<bool> = store.golden_film().depth.iter().map(|t| *t == f32::INFINITY).collect();
-        let singles: Vec<Candidate> = candidates::singles(&source.case, store.pictures())
-            .into_iter()
-            .map(|set| {
-                Ok(Candidate {
-                    set,
-                    pictures: store.get(&set)?,
+        // Each fault set with its pictures, rendered (or read from the cache) once.
+        let with_pictures = |sets: Vec<FaultSet>| -> Result<Vec<Candidate>, GradeError> {
+            sets.into_iter()
+                .map(|set| {
+                    Ok(Candidate {
+                        set,
+                        pictures: store.get(&set)?,
+                    })
                 })
-            })
-            .collect::<Result<_, crate::Error>>()
-            .map_err(render_error)?;
+                .collect::<Result<_, crate::Error>>()
+                .map_err(render_error)
+        };
+        let singles = with_pictures(candidates::singles(&source.case, store.pictures()))?;
 
         // The students' pictures and their singles' scores, in parallel.
         let subjects: Vec<Option<Subject>> = failing
@@ -384,16 +387,7 @@ pub(super) fn diagnose_class(
                 }
             }
         }
-        let expanded: Vec<Candidate> = wanted
-            .into_iter()
-            .map(|set| {
-                Ok(Candidate {
-                    set,
-                    pictures: store.get(&set)?,
-                })
-            })
-            .collect::<Result<_, crate::Error>>()
-            .map_err(render_error)?;
+        let expanded = with_pictures(wanted)?;
 
         let decided: Vec<Option<(Diagnosis, usize, usize)>> = failing
             .par_iter()
