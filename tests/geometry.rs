@@ -1,5 +1,5 @@
-//! Integration tests of the geometry module: watertight triangles, BVH traversal against brute
-//! force, mesh and OBJ loading, and the procedural blob. Shared helpers live here; the tests
+//! Integration tests of the geometry module: watertight triangles, BVH traversal and the packed
+//! (SIMD) mesh queries against brute force, mesh and OBJ loading, and the procedural blob. Shared helpers live here; the tests
 //! are split by topic into the files under `tests/geometry/`.
 
 #[path = "geometry/bvh.rs"]
@@ -8,6 +8,8 @@ mod bvh;
 mod generate;
 #[path = "geometry/obj.rs"]
 mod obj;
+#[path = "geometry/packs.rs"]
+mod packs;
 #[path = "geometry/timing.rs"]
 mod timing;
 #[path = "geometry/watertight.rs"]

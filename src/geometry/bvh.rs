@@ -13,13 +13,21 @@ use std::mem::MaybeUninit;
 
 use super::Ray;
 use super::aabb::Aabb;
-use super::real::{R8, Real, gamma};
+use super::real::{MACHINE_EPSILON, R8, Real, gamma};
 use crate::simd::{Isa, Kernel, Lanes, MaskOps, dispatch};
 
 pub use build::LeafCost;
 
 /// Children per node: eight boxes are tested at once, one per SIMD lane.
 pub const WIDTH: usize = 8;
+
+/// Boxes are pruned only when entered beyond the nearest hit so far times this: a box's entry
+/// distance and a triangle's `t` are each rounded, so a triangle lying in a face of its box may
+/// come out a few ulps nearer than the box's entry. Without the slack such a box could be
+/// skipped once another hit a few ulps farther was known, and which of the two is found would
+/// depend on the order of the traversal (a packet's, or one ray's); with it both are tested and
+/// the nearest, ties to the smaller index, wins whatever the order.
+const BOX_SLACK: Real = 1.0 + 64.0 * MACHINE_EPSILON;
 
 /// Deepest binary tree [`Bvh::build`] can produce: SAH splits are allowed up to
 /// `build::SAH_DEPTH_LIMIT` levels, after which median splits at most halve `u32::MAX` primitives
@@ -320,7 +328,7 @@ impl<I: Isa> SlabLanes<I> {
 }
 
 /// The slab test of a node's eight boxes: each box's entry distance, and a bit per box the ray
-/// meets for some `t` in `[0, t_limit]`.
+/// meets for some `t` in `[0, t_limit·BOX_SLACK]`.
 ///
 /// Conservative: it may report a hit the exact test would not, but never misses a box the
 /// ray really touches, which is what keeps traversal from losing primitives. Two details
@@ -335,7 +343,7 @@ impl<I: Isa> SlabLanes<I> {
 #[inline(always)]
 fn node_hits<I: Isa>(node: &BvhNode, ray: &SlabLanes<I>, t_limit: Real) -> (R8<I>, u32) {
     let mut t_enter = R8::<I>::splat(0.0);
-    let mut t_exit = R8::<I>::splat(t_limit);
+    let mut t_exit = R8::<I>::splat(t_limit * BOX_SLACK);
     for axis in 0..3 {
         let negative = ray.negative[axis];
         let (near, far) = (&node.bounds[negative as usize][axis], &node.bounds[!negative as usize][axis]);
@@ -489,11 +497,89 @@ pub fn traverse<I: Isa>(nodes: &[BvhNode], ray: &Ray, t_max: Real, visitor: &mut
         loop {
             let Some(pending) = stack.pop() else { return };
             // The box was hit before `t_limit` shrank; entered beyond it, it holds nothing nearer.
-            if pending.t <= t_limit {
+            if pending.t <= t_limit * BOX_SLACK {
                 current = pending;
                 break;
             }
         }
+    }
+}
+
+/// Up to eight boxes side by side, tested at once with the traversal's slab test: a handful of
+/// objects that need no tree.
+#[derive(Clone, Debug)]
+pub struct BoxSet {
+    node: BvhNode,
+    len: usize,
+}
+
+impl BoxSet {
+    /// # Panics
+    /// With more than [`WIDTH`] boxes.
+    pub fn new(bounds: &[Aabb]) -> BoxSet {
+        assert!(bounds.len() <= WIDTH, "a box set holds at most {WIDTH} boxes");
+        let mut node = BvhNode::EMPTY;
+        for (lane, bounds) in bounds.iter().enumerate() {
+            node.set_child(lane, bounds, lane as u32, 1);
+        }
+        BoxSet { node, len: bounds.len() }
+    }
+
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// A bit per box the ray enters by `t_limit` (with the traversal's slack), and where it enters
+    /// each (meaningful for those bits).
+    ///
+    /// A kernel: compile it only inside one (see `crate::simd`).
+    #[inline(always)]
+    pub fn entered<I: Isa>(&self, ray: &Ray, t_limit: Real) -> (u32, [Real; WIDTH]) {
+        let mut t = [0.0; WIDTH];
+        if !(ray.origin.is_finite() && ray.direction.is_finite()) {
+            return (0, t);
+        }
+        let (t_enter, hits) = node_hits::<I>(&self.node, &SlabLanes::<I>::new(ray), t_limit);
+        t_enter.store(&mut t);
+        (hits, t)
+    }
+
+    /// The boxes of `hits` (from [`BoxSet::entered`]) nearest first, in the low bits of keys
+    /// that sort by entry distance; `count` of them.
+    #[inline(always)]
+    pub fn nearest_first(hits: u32, t: &[Real; WIDTH]) -> ([u64; WIDTH], usize) {
+        let mut keys = [0u64; WIDTH];
+        let mut count = 0;
+        let mut remaining = hits;
+        while remaining != 0 {
+            let lane = remaining.trailing_zeros() as usize;
+            remaining &= remaining - 1;
+            let key = sort_key(t[lane], lane);
+            let mut k = count;
+            while k > 0 && keys[k - 1] > key {
+                keys[k] = keys[k - 1];
+                k -= 1;
+            }
+            keys[k] = key;
+            count += 1;
+        }
+        (keys, count)
+    }
+
+    /// The box a key of [`BoxSet::nearest_first`] stands for.
+    #[inline(always)]
+    pub fn lane(key: u64) -> usize {
+        key as usize & (WIDTH - 1)
+    }
+
+    /// Whether a box entered at `t` may hold a hit nearer than `t_limit` (the traversal's pruning).
+    #[inline(always)]
+    pub fn may_hold(t: Real, t_limit: Real) -> bool {
+        t <= t_limit * BOX_SLACK
     }
 }
 
@@ -580,7 +666,7 @@ pub fn traverse_packet<I: Isa>(
     loop {
         if current.count == 0 {
             let node = &nodes[current.index as usize];
-            let limit = R8::<I>::load(&t_limit[..]);
+            let limit = R8::<I>::load(&t_limit[..]) * R8::<I>::splat(BOX_SLACK);
             let mut children = [(0u64, 0u32); WIDTH];
             let mut hit = 0;
             for slot in 0..WIDTH {
@@ -644,7 +730,7 @@ pub fn traverse_packet<I: Isa>(
             while remaining != 0 {
                 let lane = remaining.trailing_zeros();
                 remaining &= remaining - 1;
-                if pending.t <= t_limit[lane as usize] {
+                if pending.t <= t_limit[lane as usize] * BOX_SLACK {
                     rays |= 1 << lane;
                 }
             }

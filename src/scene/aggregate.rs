@@ -2,7 +2,7 @@
 //! and everything else under a BVH.
 
 use super::geometry::aabb::{Aabb, SlabRay};
-use super::geometry::bvh::{Bvh, LeafCost, Visit, VisitFn, traverse};
+use super::geometry::bvh::{BoxSet, Bvh, LeafCost, Visit, VisitFn, WIDTH, traverse};
 use super::geometry::plane::{PLANE_LANES, Plane, PlanePack, intersect_planes};
 use super::geometry::sphere::{SPHERE_LANES, SphereRay, SpherePack, intersect_spheres};
 use super::geometry::{Ray, SurfaceHit};
@@ -33,6 +33,9 @@ enum Rest {
     /// A lone object, tested directly; behind its world box when it has a transform, since the
     /// box test costs less than moving the ray into the object's space.
     One { object: u32, bounds: Option<Aabb> },
+    /// A handful of objects behind their boxes, tested by one slab test: `objects[lane]` is the
+    /// object of box `lane`.
+    Few { boxes: Box<BoxSet>, objects: Vec<u32> },
     /// A tree whose leaves hold positions in `objects`: object indices in the tree's leaf order.
     Tree { bvh: Bvh, objects: Vec<u32> },
 }
@@ -93,6 +96,10 @@ impl Aggregate {
                 let lone = &objects[object as usize];
                 Rest::One { object, bounds: lone.transform.is_some().then(|| lone.bounds()) }
             }
+            few if few.len() <= WIDTH => {
+                let bounds: Vec<Aabb> = few.iter().map(|&index| objects[index as usize].bounds()).collect();
+                Rest::Few { boxes: Box::new(BoxSet::new(&bounds)), objects: others }
+            }
             _ => {
                 let bounds: Vec<Aabb> = others.iter().map(|&index| objects[index as usize].bounds()).collect();
                 let bvh = Bvh::build_for(&bounds, LeafCost::Single);
@@ -115,7 +122,7 @@ impl Aggregate {
     }
 
     /// The tree over the objects that are neither planes nor a handful of plain spheres, when
-    /// there are at least two of them.
+    /// there are more than eight of them (up to eight are tested by one slab test).
     pub fn bvh(&self) -> Option<&Bvh> {
         match &self.rest {
             Rest::Tree { bvh, .. } => Some(bvh),
@@ -188,6 +195,22 @@ impl Aggregate {
                     closest.offer(hit.t(), *object, Found::Object(*object, hit));
                 }
             }
+            Rest::Few { boxes, objects } => {
+                let (hits, t) = boxes.entered::<I>(ray, closest.t);
+                if hits != 0 {
+                    let (keys, count) = BoxSet::nearest_first(hits, &t);
+                    for &key in &keys[..count] {
+                        let lane = BoxSet::lane(key);
+                        if !BoxSet::may_hold(t[lane], closest.t) {
+                            break;
+                        }
+                        let index = objects[lane];
+                        if let Some(hit) = self.objects[index as usize].intersect(ray, closest.t) {
+                            closest.offer(hit.t(), index, Found::Object(index, hit));
+                        }
+                    }
+                }
+            }
             Rest::Tree { bvh, objects } => {
                 traverse::<I>(bvh.nodes(), ray, closest.t, &mut VisitFn(|first: u32, count: u32, t_limit: &mut Real| {
                     for &index in &objects[first as usize..(first + count) as usize] {
@@ -233,6 +256,17 @@ impl Aggregate {
                 bounds.is_none_or(|bounds| bounds.hit_by(&SlabRay::new(ray), t_max))
                     && self.objects[*object as usize].occluded(ray, t_max)
             }
+            Rest::Few { boxes, objects } => {
+                let (mut hits, _) = boxes.entered::<I>(ray, t_max);
+                while hits != 0 {
+                    let lane = hits.trailing_zeros() as usize;
+                    hits &= hits - 1;
+                    if self.objects[objects[lane] as usize].occluded(ray, t_max) {
+                        return true;
+                    }
+                }
+                false
+            }
             Rest::Tree { bvh, objects } => {
                 let mut blocked = false;
                 traverse::<I>(bvh.nodes(), ray, t_max, &mut VisitFn(|first: u32, count: u32, t_limit: &mut Real| {
@@ -247,5 +281,38 @@ impl Aggregate {
                 blocked
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use super::super::geometry::sphere::Sphere;
+    use super::super::real::Vec3;
+
+    fn sphere(material: u32) -> Object {
+        Object { shape: Shape::Sphere(Sphere { center: Vec3::ZERO, radius: 1.0 }), transform: None, material }
+    }
+
+    fn first_material(aggregate: &Aggregate) -> u32 {
+        let ray = Ray::new(Vec3::new(0.1, 0.2, 5.0), Vec3::new(0.0, 0.0, -1.0));
+        aggregate.intersect(&ray).expect("hit").material
+    }
+
+    /// Coinciding surfaces are hit at exactly the same `t`: the object listed first wins, whether
+    /// the spheres are tested side by side or in a tree, and objects win over planes.
+    #[test]
+    fn of_surfaces_hit_at_the_same_t_the_first_listed_wins() {
+        for count in [2, 8, 9, 20] {
+            let aggregate = Aggregate::new((0..count).map(sphere).collect(), Vec::new());
+            assert_eq!(aggregate.bvh().is_some(), count as usize > SPHERE_PACK_LIMIT, "{count} spheres");
+            assert_eq!(first_material(&aggregate), 0, "{count} spheres");
+        }
+        let on_the_sphere = Plane::new(Vec3::Z, 1.0);
+        let aggregate = Aggregate::new(vec![sphere(3)], vec![(on_the_sphere, 7), (on_the_sphere, 8)]);
+        let ray = Ray::new(Vec3::new(0.0, 0.0, 5.0), Vec3::new(0.0, 0.0, -1.0));
+        assert_eq!(aggregate.intersect(&ray).expect("hit").material, 3);
+        let planes_only = Aggregate::new(Vec::new(), vec![(on_the_sphere, 7), (on_the_sphere, 8)]);
+        assert_eq!(planes_only.intersect(&ray).expect("hit").material, 7);
     }
 }

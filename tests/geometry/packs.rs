@@ -1,0 +1,112 @@
+//! The mesh's packed queries (four triangles per test, eight rays per packet) find exactly what
+//! testing every triangle alone with `intersect_triangle` finds, including which triangle wins a
+//! tie of `t`: the one with the smaller index.
+
+use goldray::geometry::Ray;
+use goldray::geometry::bvh::PACKET;
+use goldray::geometry::mesh::{Mesh, MeshHit, VertexNormals};
+use goldray::geometry::triangle::{TriangleRay, intersect_triangle};
+use goldray::real::{Real, Vec3};
+use proptest::prelude::*;
+
+use super::{Rng, ray_through};
+
+/// The nearest hit over every triangle of the mesh, ties to the smaller index, as `Mesh` numbers
+/// its triangles.
+fn brute_force(mesh: &Mesh, ray: &Ray, t_max: Real) -> Option<MeshHit> {
+    let triangle_ray = TriangleRay::new(ray);
+    let mut closest: Option<MeshHit> = None;
+    for triangle in 0..mesh.triangle_count() as u32 {
+        let [p0, p1, p2] = mesh.triangle(triangle);
+        if let Some(hit) = intersect_triangle(&triangle_ray, t_max, p0, p1, p2)
+            && closest.is_none_or(|best| hit.t < best.t)
+        {
+            closest = Some(MeshHit {
+                t: hit.t,
+                triangle,
+                barycentrics: [hit.b0, hit.b1, hit.b2],
+            });
+        }
+    }
+    closest
+}
+
+/// A soup of random triangles, with some duplicated and some sharing a plane, so that ties of
+/// `t` happen; and rays aimed at them in fans of eight from one point.
+fn check(seed: u64, count: usize) -> usize {
+    let mut rng = Rng::new(seed);
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    for i in 0..count {
+        let centre = rng.in_box(8.0);
+        let corners = if i % 7 == 3 {
+            // In the plane z = 1, where several overlap.
+            [0; 3].map(|_| Vec3::new(rng.uniform(-2.0, 2.0), rng.uniform(-2.0, 2.0), 1.0))
+        } else {
+            [0; 3].map(|_| centre + rng.in_box(1.5))
+        };
+        let first = positions.len() as u32;
+        positions.extend(corners);
+        triangles.push([first, first + 1, first + 2]);
+        if i % 5 == 0 {
+            triangles.push([first, first + 1, first + 2]);
+        }
+    }
+    let mesh = Mesh::new(&positions, &triangles, VertexNormals::Averaged).expect("valid");
+    let mut hits = 0;
+    for fan in 0..60 {
+        let origin = rng.in_box(20.0);
+        let aim = rng.in_box(6.0);
+        let t_max = if fan % 4 == 0 {
+            rng.uniform(5.0, 30.0)
+        } else {
+            Real::INFINITY
+        };
+        let rays: Vec<Ray> = (0..PACKET)
+            .map(|_| {
+                if fan % 3 == 0 {
+                    ray_through(origin, rng.in_box(8.0))
+                } else {
+                    ray_through(origin, aim + rng.in_box(0.5))
+                }
+            })
+            .collect();
+        let packet = mesh.intersect_packet(&rays, t_max);
+        for (ray, from_packet) in rays.iter().zip(packet) {
+            let expected = brute_force(&mesh, ray, t_max);
+            assert_eq!(mesh.intersect(ray, t_max), expected, "one ray {ray:?}");
+            assert_eq!(from_packet, expected, "in a packet {ray:?}");
+            assert_eq!(mesh.occluded(ray, t_max), expected.is_some(), "occlusion {ray:?}");
+            hits += expected.is_some() as usize;
+        }
+    }
+    hits
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(6))]
+    #[test]
+    fn packed_queries_agree_with_every_triangle_tested_alone(seed in any::<u64>()) {
+        prop_assert!(check(seed, 400) > 40);
+    }
+}
+
+#[test]
+fn of_coinciding_triangles_the_smaller_index_wins() {
+    let positions = [
+        Vec3::new(-1.0, -1.0, 0.0),
+        Vec3::new(1.0, -1.0, 0.0),
+        Vec3::new(0.0, 1.0, 0.0),
+    ];
+    // Twenty copies of one triangle: every ray that hits one hits all at the same t.
+    let mesh = Mesh::new(&positions, &[[0, 1, 2]; 20], VertexNormals::Averaged).expect("valid");
+    let rays: Vec<Ray> = (0..PACKET)
+        .map(|k| Ray::new(Vec3::new(k as Real * 0.05 - 0.2, 0.0, 3.0), Vec3::new(0.0, 0.1, -1.0)))
+        .collect();
+    let packet = mesh.intersect_packet(&rays, Real::INFINITY);
+    for (ray, from_packet) in rays.iter().zip(packet) {
+        let hit = mesh.intersect(ray, Real::INFINITY).expect("hit");
+        assert_eq!(hit.triangle, 0);
+        assert_eq!(from_packet, Some(hit));
+    }
+}
