@@ -1,19 +1,22 @@
 //! Triangle meshes with their own BVH, built once and shared (behind an `Arc`) by every
 //! instance that places the mesh in a scene.
 
+mod leaf_tests;
+
 use std::time::{Duration, Instant};
 
 use super::aabb::Aabb;
 use super::huge_page_vec;
-use super::bvh::{Bvh, LeafCost, LeafVisitor, PACKET, PacketLanes, PacketVisitor, Visit, traverse, traverse_packet};
+use super::bvh::{Bvh, LeafCost, PACKET, PacketLanes, traverse, traverse_packet};
 use super::triangle::{
-    PackRay, RayLanes, TriangleHit, TrianglePack, face_normal, intersect_pack, intersect_triangle_rays, lane_hit, normalize,
+    PackRay, RayLanes, TriangleHit, TrianglePack, face_normal, normalize,
     triangle_surface,
 };
 use super::{Ray, SurfaceHit};
-use super::real::{R8, Real, Vec3};
+use super::real::{Real, Vec3};
 pub use crate::build_error::MeshError;
-use crate::simd::{Isa, Kernel, Lanes, dispatch};
+use leaf_tests::{AnyTriangle, NearestTriangle, NearestTriangles};
+use crate::simd::{Isa, Kernel, dispatch};
 use rayon::prelude::*;
 
 /// The vertex normals a mesh is built with.
@@ -229,105 +232,6 @@ impl Mesh {
     /// the vertex normals).
     pub fn bvh_build_time(&self) -> Duration {
         self.bvh_build_time
-    }
-}
-
-/// The leaf test of [`Mesh::intersect`]: each pack of the leaf, keeping the nearest hit (the
-/// smaller triangle index among hits at the same `t`).
-struct NearestTriangle<'a, I: Isa> {
-    mesh: &'a Mesh,
-    ray: PackRay<I>,
-    closest: Option<MeshHit>,
-}
-
-impl<I: Isa> LeafVisitor<I> for NearestTriangle<'_, I> {
-    #[inline(always)]
-    fn leaf(&mut self, first: u32, count: u32, t_limit: &mut Real) -> Visit {
-        for pack in &self.mesh.packs[first as usize..(first + count) as usize] {
-            let found = intersect_pack::<I>(pack, &self.ray, *t_limit);
-            let mut lanes = found.lanes;
-            if lanes == 0 {
-                continue;
-            }
-            let values = found.lanes();
-            while lanes != 0 {
-                let lane = lanes.trailing_zeros() as usize;
-                lanes &= lanes - 1;
-                let (t, triangle) = (values[0][lane], pack.ids()[lane]);
-                let nearer = match &self.closest {
-                    Some(best) => t < best.t || (t == best.t && triangle < best.triangle),
-                    None => true,
-                };
-                if nearer {
-                    let hit = lane_hit(&values, lane);
-                    *t_limit = t;
-                    self.closest = Some(MeshHit { t, triangle, barycentrics: [hit.b0, hit.b1, hit.b2] });
-                }
-            }
-        }
-        Visit::Continue
-    }
-}
-
-/// The leaf test of [`Mesh::occluded`]: stops at the first pack with a hit.
-struct AnyTriangle<'a, I: Isa> {
-    mesh: &'a Mesh,
-    ray: PackRay<I>,
-    found: bool,
-}
-
-impl<I: Isa> LeafVisitor<I> for AnyTriangle<'_, I> {
-    #[inline(always)]
-    fn leaf(&mut self, first: u32, count: u32, t_limit: &mut Real) -> Visit {
-        for pack in &self.mesh.packs[first as usize..(first + count) as usize] {
-            if intersect_pack::<I>(pack, &self.ray, *t_limit).lanes != 0 {
-                self.found = true;
-                return Visit::Stop;
-            }
-        }
-        Visit::Continue
-    }
-}
-
-/// The leaf test of [`Mesh::intersect_packet`]: each triangle of the leaf against the rays
-/// that reached it, keeping each ray's nearest hit as [`NearestTriangle`] does.
-struct NearestTriangles<'a, I: Isa> {
-    mesh: &'a Mesh,
-    rays: RayLanes<I>,
-    closest: [Option<MeshHit>; PACKET],
-}
-
-impl<I: Isa> PacketVisitor<I> for NearestTriangles<'_, I> {
-    #[inline(always)]
-    fn leaf(&mut self, first: u32, count: u32, rays: u32, t_limit: &mut [Real; PACKET]) {
-        for pack in &self.mesh.packs[first as usize..(first + count) as usize] {
-            let mut live = pack.live();
-            while live != 0 {
-                let triangle = live.trailing_zeros() as usize;
-                live &= live - 1;
-                let found = intersect_triangle_rays::<I>(pack, triangle, &self.rays, R8::<I>::load(&t_limit[..]));
-                let mut lanes = found.lanes & rays;
-                if lanes == 0 {
-                    continue;
-                }
-                let values = found.lanes();
-                let id = pack.ids()[triangle];
-                while lanes != 0 {
-                    let lane = lanes.trailing_zeros() as usize;
-                    lanes &= lanes - 1;
-                    let t = values[0][lane];
-                    let nearer = match &self.closest[lane] {
-                        Some(best) => t < best.t || (t == best.t && id < best.triangle),
-                        None => true,
-                    };
-                    if nearer {
-                        let hit = lane_hit(&values, lane);
-                        t_limit[lane] = t;
-                        self.closest[lane] = Some(MeshHit { t, triangle: id, barycentrics: [hit.b0, hit.b1, hit.b2] });
-                    }
-                }
-            }
-        }
     }
 }
 

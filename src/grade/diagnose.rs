@@ -674,6 +674,9 @@ fn decide(
     };
     let file = &subject.spec.file;
     let student = Image::from_rgb8(subject.student.clone(), file.clone());
+    let write = |set: &FaultSet, mistake: &RgbImage, expected: &Image| {
+        write_pictures(set, mistake, expected, &student, subject, out, student_dir, written)
+    };
     for scored in order {
         let Some(mistake) = picture_of(&scored.set) else {
             continue;
@@ -706,16 +709,7 @@ fn decide(
                 }
                 ids
             });
-        let (mistake_image, residual_image) = write_pictures(
-            &scored.set,
-            &mistake,
-            &expected,
-            &student,
-            subject,
-            out,
-            student_dir,
-            written,
-        );
+        let (mistake_image, residual_image) = write(&scored.set, &mistake, &expected);
         return Diagnosis {
             id: scored.set.id(),
             faults: Some(scored.set.to_string()),
@@ -755,16 +749,7 @@ fn decide(
         && let Some(mistake) = picture_of(&closest.set)
     {
         let expected = Image::from_rgb8(mistake.clone(), closest.set.to_string());
-        (mistake_image, residual_image) = write_pictures(
-            &closest.set,
-            &mistake,
-            &expected,
-            &student,
-            subject,
-            out,
-            student_dir,
-            written,
-        );
+        (mistake_image, residual_image) = write(&closest.set, &mistake, &expected);
     }
     Diagnosis {
         id: UNEXPLAINED.to_owned(),

@@ -1,0 +1,87 @@
+//! A handful of boxes tested at once without a tree.
+
+use super::super::Ray;
+use super::super::aabb::Aabb;
+use super::super::real::Real;
+use crate::simd::{Isa, Lanes};
+use super::*;
+use super::traverse::{SlabLanes, node_hits, sort_key};
+
+/// Up to eight boxes side by side, tested at once with the traversal's slab test: a handful of
+/// objects that need no tree.
+#[derive(Clone, Debug)]
+pub struct BoxSet {
+    node: BvhNode,
+    len: usize,
+}
+
+impl BoxSet {
+    /// # Panics
+    /// With more than [`WIDTH`] boxes.
+    pub fn new(bounds: &[Aabb]) -> BoxSet {
+        assert!(bounds.len() <= WIDTH, "a box set holds at most {WIDTH} boxes");
+        let mut node = BvhNode::EMPTY;
+        for (lane, bounds) in bounds.iter().enumerate() {
+            node.set_child(lane, bounds, lane as u32, 1);
+        }
+        BoxSet { node, len: bounds.len() }
+    }
+
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// A bit per box the ray enters by `t_limit` (with the traversal's slack), and where it enters
+    /// each (meaningful for those bits).
+    ///
+    /// A kernel: compile it only inside one (see `crate::simd`).
+    #[inline(always)]
+    pub fn entered<I: Isa>(&self, ray: &Ray, t_limit: Real) -> (u32, [Real; WIDTH]) {
+        let mut t = [0.0; WIDTH];
+        if !(ray.origin.is_finite() && ray.direction.is_finite()) {
+            return (0, t);
+        }
+        let (t_enter, hits) = node_hits::<I>(&self.node, &SlabLanes::<I>::new(ray), t_limit);
+        t_enter.store(&mut t);
+        (hits, t)
+    }
+
+    /// The boxes of `hits` (from [`BoxSet::entered`]) nearest first, in the low bits of keys
+    /// that sort by entry distance; `count` of them.
+    #[inline(always)]
+    pub fn nearest_first(hits: u32, t: &[Real; WIDTH]) -> ([u64; WIDTH], usize) {
+        let mut keys = [0u64; WIDTH];
+        let mut count = 0;
+        let mut remaining = hits;
+        while remaining != 0 {
+            let lane = remaining.trailing_zeros() as usize;
+            remaining &= remaining - 1;
+            let key = sort_key(t[lane], lane);
+            let mut k = count;
+            while k > 0 && keys[k - 1] > key {
+                keys[k] = keys[k - 1];
+                k -= 1;
+            }
+            keys[k] = key;
+            count += 1;
+        }
+        (keys, count)
+    }
+
+    /// The box a key of [`BoxSet::nearest_first`] stands for.
+    #[inline(always)]
+    pub fn lane(key: u64) -> usize {
+        key as usize & (WIDTH - 1)
+    }
+
+    /// Whether a box entered at `t` may hold a hit nearer than `t_limit` (the traversal's pruning).
+    #[inline(always)]
+    pub fn may_hold(t: Real, t_limit: Real) -> bool {
+        t <= t_limit * BOX_SLACK
+    }
+}
+

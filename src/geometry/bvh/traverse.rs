@@ -1,0 +1,214 @@
+//! One ray's traversal of the 8-wide tree: the slab test of a node's eight boxes, the nearest
+//! child visited first, and the stack of children waiting.
+
+use super::super::Ray;
+use super::super::real::{R8, Real};
+use crate::simd::{Isa, Lanes, MaskOps};
+use super::*;
+
+/// The per-ray part of the slab test, splatted across the lanes once per ray.
+pub(super) struct SlabLanes<I: Isa> {
+    origin: [R8<I>; 3],
+    /// `1 / direction` per component; ±∞ where the direction component is ±0.
+    inverse: [R8<I>; 3],
+    /// The inverse widened by `1 + 2·gamma(3)`, for the far planes (see [`node_hits`]).
+    far_inverse: [R8<I>; 3],
+    /// Chooses the near and far plane of each slab. Taken from the inverse so that a direction
+    /// of −0.0 counts as negative, consistently with its −∞ inverse.
+    negative: [bool; 3],
+}
+
+impl<I: Isa> SlabLanes<I> {
+    #[inline(always)]
+    pub(super) fn new(ray: &Ray) -> Self {
+        // Spelled out rather than mapped: a closure passed to `map` may be compiled outside the
+        // kernel, without its instructions.
+        let inverse = ray.direction.recip();
+        let far_inverse = inverse * (1.0 + 2.0 * gamma(3));
+        let (o, i, f) = (ray.origin, inverse, far_inverse);
+        SlabLanes {
+            origin: [R8::<I>::splat(o.x), R8::<I>::splat(o.y), R8::<I>::splat(o.z)],
+            inverse: [R8::<I>::splat(i.x), R8::<I>::splat(i.y), R8::<I>::splat(i.z)],
+            far_inverse: [R8::<I>::splat(f.x), R8::<I>::splat(f.y), R8::<I>::splat(f.z)],
+            negative: [inverse.x < 0.0, inverse.y < 0.0, inverse.z < 0.0],
+        }
+    }
+}
+
+/// The slab test of a node's eight boxes: each box's entry distance, and a bit per box the ray
+/// meets for some `t` in `[0, t_limit·BOX_SLACK]`.
+///
+/// Conservative: it may report a hit the exact test would not, but never misses a box the
+/// ray really touches, which is what keeps traversal from losing primitives. Two details
+/// make that so. The far distance on each axis is widened by `1 + 2·gamma(3)` (pbrt-v4), which
+/// covers the rounding of the inverse, the subtraction and the multiplication; it is folded
+/// into the inverse once per ray, which adds one more rounding of `u`, still well inside the
+/// `6u` of the widening (`(1 − u)⁴·(1 + 2·gamma(3)) > 1`). And a zero direction component
+/// gives an infinite inverse, so an origin lying exactly on that slab's plane computes
+/// `0 · ∞ = NaN`; `max`/`min` keep their second operand for a NaN, so that slab then constrains
+/// nothing, i.e. the plane counts as inside the box, as a closed box should. An empty box
+/// (`min = +∞`, `max = −∞`) is never hit: its far distance is `−∞` on every axis.
+#[inline(always)]
+pub(super) fn node_hits<I: Isa>(node: &BvhNode, ray: &SlabLanes<I>, t_limit: Real) -> (R8<I>, u32) {
+    let mut t_enter = R8::<I>::splat(0.0);
+    let mut t_exit = R8::<I>::splat(t_limit * BOX_SLACK);
+    for axis in 0..3 {
+        let negative = ray.negative[axis];
+        let (near, far) = (&node.bounds[negative as usize][axis], &node.bounds[!negative as usize][axis]);
+        let t_near = (R8::<I>::load(near) - ray.origin[axis]) * ray.inverse[axis];
+        let t_far = (R8::<I>::load(far) - ray.origin[axis]) * ray.far_inverse[axis];
+        t_enter = t_near.max(t_enter);
+        t_exit = t_far.min(t_exit);
+    }
+    (t_enter, t_enter.le(t_exit).bits())
+}
+
+/// A key that sorts children by the distance at which the ray enters them (non-negative and
+/// never NaN, so the bits of the float order as it does) and carries the child's lane in its
+/// low bits. In `f64` the distance's three lowest bits make way for the lane: the order only
+/// decides how soon a child is visited, never which hit is found.
+#[inline(always)]
+pub(super) fn sort_key(t: Real, lane: usize) -> u64 {
+    let bits = t.to_bits() as u64;
+    let key = if size_of::<Real>() == 4 { bits << 3 } else { bits & !7 };
+    key | lane as u64
+}
+
+/// Entries the traversal stack holds in place before it spills to the heap. Rays rarely need
+/// more than a few dozen, and a small frame keeps the kernels that do not traverse cheap.
+const INLINE_STACK: usize = 64;
+
+/// The traversal stack: `INLINE_STACK` entries inline and, unlike an array, not initialised
+/// (zeroing them for every ray would cost more than most rays push), then a vector for the
+/// deepest trees (at most `STACK_SIZE` entries in all), allocated only if ever needed.
+struct Stack {
+    entries: [MaybeUninit<Pending>; INLINE_STACK],
+    len: usize,
+    spilled: Vec<Pending>,
+}
+
+impl Stack {
+    #[inline(always)]
+    fn new() -> Self {
+        Stack { entries: [const { MaybeUninit::uninit() }; INLINE_STACK], len: 0, spilled: Vec::new() }
+    }
+
+    #[inline(always)]
+    fn push(&mut self, entry: Pending) {
+        if self.len < INLINE_STACK {
+            self.entries[self.len] = MaybeUninit::new(entry);
+            self.len += 1;
+        } else {
+            self.spill(entry);
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn spill(&mut self, entry: Pending) {
+        debug_assert!(self.spilled.len() + INLINE_STACK < STACK_SIZE);
+        self.spilled.push(entry);
+    }
+
+    #[inline(always)]
+    fn pop(&mut self) -> Option<Pending> {
+        if !self.spilled.is_empty() {
+            return self.spilled.pop();
+        }
+        if self.len == 0 {
+            return None;
+        }
+        self.len -= 1;
+        // SAFETY: entries below `len` were written by `push`.
+        Some(unsafe { self.entries[self.len].assume_init() })
+    }
+}
+
+/// A child that waits on the stack is fetched from memory meanwhile.
+#[inline(always)]
+fn fetch_node<I: Isa>(nodes: &[BvhNode], pending: &Pending) {
+    if pending.count == 0 {
+        let waiting: *const BvhNode = &nodes[pending.index as usize];
+        for line in 0..size_of::<BvhNode>().div_ceil(64) {
+            I::prefetch(waiting.cast::<u8>().wrapping_add(64 * line));
+        }
+    }
+}
+
+/// Depth-first traversal with an explicit stack, nearest child first: each node's eight boxes
+/// are tested at once, the children hit are ordered by where the ray enters them, the nearest
+/// is visited next and the others wait on the stack with their entry distance. `visit(first,
+/// count, t_limit)` is called for each leaf reached; it may shrink `t_limit`, which prunes every
+/// box entered beyond it (a box entered exactly at the limit is still visited).
+///
+/// A kernel: compile it only inside one (see `crate::simd`).
+#[inline(always)]
+pub fn traverse<I: Isa>(nodes: &[BvhNode], ray: &Ray, t_max: Real, visitor: &mut impl LeafVisitor<I>) {
+    if nodes.is_empty() || !(ray.origin.is_finite() && ray.direction.is_finite()) {
+        return;
+    }
+    let slab = SlabLanes::<I>::new(ray);
+    let mut t_limit = t_max;
+    let mut stack = Stack::new();
+    let mut current = Pending { t: 0.0, index: 0, count: 0 };
+    loop {
+        if current.count == 0 {
+            let node = &nodes[current.index as usize];
+            let (t_enter, hits) = node_hits::<I>(node, &slab, t_limit);
+            if hits != 0 {
+                let first = hits.trailing_zeros() as usize;
+                let rest = hits & (hits - 1);
+                if rest == 0 {
+                    current = Pending { t: 0.0, index: node.child[first], count: node.count[first] };
+                    continue;
+                }
+                let mut t = [0.0; WIDTH];
+                t_enter.store(&mut t);
+                let child = |lane: usize| Pending { t: t[lane], index: node.child[lane], count: node.count[lane] };
+                let fetch = |pending: &Pending| fetch_node::<I>(nodes, pending);
+                if rest & (rest - 1) == 0 {
+                    // Two children, the common case: the farther one waits.
+                    let second = rest.trailing_zeros() as usize;
+                    let (near, far) = if t[second] < t[first] { (second, first) } else { (first, second) };
+                    fetch(&child(far));
+                    stack.push(child(far));
+                    current = child(near);
+                    continue;
+                }
+                // More: sort keys that order by entry distance and carry the lane, nearest first.
+                let mut keys = [0u64; WIDTH];
+                let mut len = 0;
+                let mut remaining = hits;
+                while remaining != 0 {
+                    let lane = remaining.trailing_zeros() as usize;
+                    remaining &= remaining - 1;
+                    let key = sort_key(t[lane], lane);
+                    let mut k = len;
+                    while k > 0 && keys[k - 1] > key {
+                        keys[k] = keys[k - 1];
+                        k -= 1;
+                    }
+                    keys[k] = key;
+                    len += 1;
+                }
+                for &key in keys[1..len].iter().rev() {
+                    let waiting = child(key as usize & (WIDTH - 1));
+                    fetch(&waiting);
+                    stack.push(waiting);
+                }
+                current = child(keys[0] as usize & (WIDTH - 1));
+                continue;
+            }
+        } else if let Visit::Stop = visitor.leaf(current.index, current.count, &mut t_limit) {
+            return;
+        }
+        loop {
+            let Some(pending) = stack.pop() else { return };
+            // The box was hit before `t_limit` shrank; entered beyond it, it holds nothing nearer.
+            if pending.t <= t_limit * BOX_SLACK {
+                current = pending;
+                break;
+            }
+        }
+    }
+}

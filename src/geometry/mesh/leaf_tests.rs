@@ -1,0 +1,107 @@
+//! The leaf tests the mesh's traversals run: packs of four triangles against one ray (nearest
+//! hit, or any hit for shadow rays) and one triangle at a time against a packet of rays.
+
+use super::super::bvh::{LeafVisitor, PACKET, PacketVisitor, Visit};
+use super::super::real::{R8, Real};
+use super::super::triangle::{PackRay, RayLanes, intersect_pack, intersect_triangle_rays, lane_hit};
+use super::{Mesh, MeshHit};
+use crate::simd::{Isa, Lanes};
+
+/// The leaf test of [`Mesh::intersect`]: each pack of the leaf, keeping the nearest hit (the
+/// smaller triangle index among hits at the same `t`).
+pub(super) struct NearestTriangle<'a, I: Isa> {
+    pub(super) mesh: &'a Mesh,
+    pub(super) ray: PackRay<I>,
+    pub(super) closest: Option<MeshHit>,
+}
+
+impl<I: Isa> LeafVisitor<I> for NearestTriangle<'_, I> {
+    #[inline(always)]
+    fn leaf(&mut self, first: u32, count: u32, t_limit: &mut Real) -> Visit {
+        for pack in &self.mesh.packs[first as usize..(first + count) as usize] {
+            let found = intersect_pack::<I>(pack, &self.ray, *t_limit);
+            let mut lanes = found.lanes;
+            if lanes == 0 {
+                continue;
+            }
+            let values = found.values::<4>();
+            while lanes != 0 {
+                let lane = lanes.trailing_zeros() as usize;
+                lanes &= lanes - 1;
+                let (t, triangle) = (values[0][lane], pack.ids()[lane]);
+                let nearer = match &self.closest {
+                    Some(best) => t < best.t || (t == best.t && triangle < best.triangle),
+                    None => true,
+                };
+                if nearer {
+                    let hit = lane_hit(&values, lane);
+                    *t_limit = t;
+                    self.closest = Some(MeshHit { t, triangle, barycentrics: [hit.b0, hit.b1, hit.b2] });
+                }
+            }
+        }
+        Visit::Continue
+    }
+}
+
+/// The leaf test of [`Mesh::occluded`]: stops at the first pack with a hit.
+pub(super) struct AnyTriangle<'a, I: Isa> {
+    pub(super) mesh: &'a Mesh,
+    pub(super) ray: PackRay<I>,
+    pub(super) found: bool,
+}
+
+impl<I: Isa> LeafVisitor<I> for AnyTriangle<'_, I> {
+    #[inline(always)]
+    fn leaf(&mut self, first: u32, count: u32, t_limit: &mut Real) -> Visit {
+        for pack in &self.mesh.packs[first as usize..(first + count) as usize] {
+            if intersect_pack::<I>(pack, &self.ray, *t_limit).lanes != 0 {
+                self.found = true;
+                return Visit::Stop;
+            }
+        }
+        Visit::Continue
+    }
+}
+
+/// The leaf test of [`Mesh::intersect_packet`]: each triangle of the leaf against the rays
+/// that reached it, keeping each ray's nearest hit as [`NearestTriangle`] does.
+pub(super) struct NearestTriangles<'a, I: Isa> {
+    pub(super) mesh: &'a Mesh,
+    pub(super) rays: RayLanes<I>,
+    pub(super) closest: [Option<MeshHit>; PACKET],
+}
+
+impl<I: Isa> PacketVisitor<I> for NearestTriangles<'_, I> {
+    #[inline(always)]
+    fn leaf(&mut self, first: u32, count: u32, rays: u32, t_limit: &mut [Real; PACKET]) {
+        for pack in &self.mesh.packs[first as usize..(first + count) as usize] {
+            let mut live = pack.live();
+            while live != 0 {
+                let triangle = live.trailing_zeros() as usize;
+                live &= live - 1;
+                let found = intersect_triangle_rays::<I>(pack, triangle, &self.rays, R8::<I>::load(&t_limit[..]));
+                let mut lanes = found.lanes & rays;
+                if lanes == 0 {
+                    continue;
+                }
+                let values = found.values::<8>();
+                let id = pack.ids()[triangle];
+                while lanes != 0 {
+                    let lane = lanes.trailing_zeros() as usize;
+                    lanes &= lanes - 1;
+                    let t = values[0][lane];
+                    let nearer = match &self.closest[lane] {
+                        Some(best) => t < best.t || (t == best.t && id < best.triangle),
+                        None => true,
+                    };
+                    if nearer {
+                        let hit = lane_hit(&values, lane);
+                        t_limit[lane] = t;
+                        self.closest[lane] = Some(MeshHit { t, triangle: id, barycentrics: [hit.b0, hit.b1, hit.b2] });
+                    }
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,276 @@
+//! The watertight test of [`super::intersect_triangle`] on several lanes at once: four triangles
+//! against one ray ([`intersect_pack`], for a mesh's leaves) and one triangle against eight rays
+//! ([`intersect_triangle_rays`], for packets). Lane by lane the operations are the one-ray
+//! test's, so every `t` and barycentric is what that test gives.
+
+use super::super::real::{R4, R8, Real, Vec3, edge8, gamma, narrow4, wide4};
+use super::super::Ray;
+use super::*;
+use crate::simd::{Isa, Lanes, MaskOps};
+
+/// Four triangles side by side, one per SIMD lane, for [`intersect_pack`]: the same watertight
+/// test as [`intersect_triangle`], operation for operation, on four triangles at once.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(16))]
+pub struct TrianglePack {
+    /// `corners[vertex][axis][lane]`.
+    corners: [[[Real; 4]; 3]; 3],
+    /// Each lane's triangle, as the mesh numbers it.
+    ids: [u32; 4],
+    /// Bit per lane holding a triangle that can be hit: not padding, not of zero area.
+    live: u32,
+}
+
+impl TrianglePack {
+    /// Packs one to four `(id, corners)`; the remaining lanes are padding that no ray hits.
+    /// Zero-area triangles are kept (their ids stay in place) but never hit, as in
+    /// [`intersect_triangle`].
+    pub fn new(triangles: &[(u32, [Vec3; 3])]) -> TrianglePack {
+        assert!((1..=4).contains(&triangles.len()), "a pack holds one to four triangles");
+        let mut pack = TrianglePack { corners: [[[0.0; 4]; 3]; 3], ids: [u32::MAX; 4], live: 0 };
+        for (lane, &(id, [p0, p1, p2])) in triangles.iter().enumerate() {
+            for (vertex, p) in [p0, p1, p2].into_iter().enumerate() {
+                for axis in 0..3 {
+                    pack.corners[vertex][axis][lane] = p[axis];
+                }
+            }
+            pack.ids[lane] = id;
+            if (p2 - p0).cross(p1 - p0).length_squared() != 0.0 {
+                pack.live |= 1 << lane;
+            }
+        }
+        pack
+    }
+
+    pub fn ids(&self) -> &[u32; 4] {
+        &self.ids
+    }
+}
+
+/// [`TriangleRay`] splatted across the lanes of a pack test.
+pub struct PackRay<I: Isa> {
+    /// Which axes become x, y and z (the permutation of [`TriangleRay`]).
+    axes: [usize; 3],
+    /// The origin's permuted components.
+    origin: [R4<I>; 3],
+    shear: [R4<I>; 3],
+}
+
+impl<I: Isa> PackRay<I> {
+    #[inline(always)]
+    pub fn new(ray: &Ray) -> Self {
+        let triangle_ray = TriangleRay::new(ray);
+        let axes = match triangle_ray.axis_z {
+            0 => [1, 2, 0],
+            1 => [2, 0, 1],
+            _ => [0, 1, 2],
+        };
+        let shear = triangle_ray.shear;
+        PackRay {
+            axes,
+            origin: [
+                R4::<I>::splat(ray.origin[axes[0]]),
+                R4::<I>::splat(ray.origin[axes[1]]),
+                R4::<I>::splat(ray.origin[axes[2]]),
+            ],
+            shear: [R4::<I>::splat(shear.x), R4::<I>::splat(shear.y), R4::<I>::splat(shear.z)],
+        }
+    }
+}
+
+/// What a lane-parallel triangle test found: the lanes hit within the limit, and per lane the
+/// values a hit is made of (`t`, and the edge functions and inverse determinant its barycentrics
+/// come from). `L` is four lanes for [`intersect_pack`] (four triangles, one ray) and eight for
+/// [`intersect_triangle_rays`] (one triangle, eight rays).
+pub struct LaneHits<L> {
+    /// Bit per lane hit in `(0, t_max]`.
+    pub lanes: u32,
+    t: L,
+    edges: [L; 3],
+    inv_det: L,
+}
+
+/// What [`intersect_pack`] found.
+pub type PackHits<I> = LaneHits<R4<I>>;
+
+/// What [`intersect_triangle_rays`] found.
+pub type RayHits<I> = LaneHits<R8<I>>;
+
+impl<L: Lanes<Elem = Real>> LaneHits<L> {
+    /// What each lane's hit is made of: `t`, the three edge functions and the inverse
+    /// determinant; meaningful for `lanes` only. `N` is the lane count.
+    #[inline(always)]
+    pub fn values<const N: usize>(&self) -> [[Real; N]; 5] {
+        debug_assert_eq!(N, L::N);
+        let mut values = [[0.0; N]; 5];
+        self.t.store(&mut values[0]);
+        self.edges[0].store(&mut values[1]);
+        self.edges[1].store(&mut values[2]);
+        self.edges[2].store(&mut values[3]);
+        self.inv_det.store(&mut values[4]);
+        values
+    }
+}
+
+/// Lane `lane` of [`LaneHits::values`], as [`intersect_triangle`] would
+/// report it.
+#[inline(always)]
+pub fn lane_hit<const N: usize>(values: &[[Real; N]; 5], lane: usize) -> TriangleHit {
+    let inv_det = values[4][lane];
+    TriangleHit { t: values[0][lane], b0: values[1][lane] * inv_det, b1: values[2][lane] * inv_det, b2: values[3][lane] * inv_det }
+}
+
+/// Vertex `v` of each lane of `pack`, relative to the origin, permuted and sheared.
+#[inline(always)]
+fn pack_vertex<I: Isa>(pack: &TrianglePack, ray: &PackRay<I>, v: usize) -> [R4<I>; 3] {
+    let [kx, ky, kz] = ray.axes;
+    let corner = &pack.corners[v];
+    let qx = R4::<I>::load(&corner[kx]) - ray.origin[0];
+    let qy = R4::<I>::load(&corner[ky]) - ray.origin[1];
+    let qz = R4::<I>::load(&corner[kz]) - ray.origin[2];
+    [qx + ray.shear[0] * qz, qy + ray.shear[1] * qz, qz]
+}
+
+/// [`edge_function`] on four lanes.
+#[inline(always)]
+fn pack_edge<I: Isa>(a: &[R4<I>; 3], b: &[R4<I>; 3]) -> R4<I> {
+    narrow4::<I>(wide4::<I>(a[0]) * wide4::<I>(b[1]) - wide4::<I>(a[1]) * wide4::<I>(b[0]))
+}
+
+/// `max(|a|, max(|b|, |c|))` per lane (`Vec3::abs().max_element()`).
+#[inline(always)]
+fn max_abs3<L: Lanes>(a: L, b: L, c: L) -> L {
+    a.abs().max(b.abs().max(c.abs()))
+}
+
+/// [`intersect_triangle`] on the four lanes of `pack`, with the same operations in the same
+/// order, so that each lane's `t` and barycentrics are bit for bit those of the one-triangle test.
+///
+/// A kernel: compile it only inside one (see `crate::simd`).
+#[inline(always)]
+pub fn intersect_pack<I: Isa>(pack: &TrianglePack, ray: &PackRay<I>, t_max: Real) -> PackHits<I> {
+    let (p0, p1, p2) = (pack_vertex(pack, ray, 0), pack_vertex(pack, ray, 1), pack_vertex(pack, ray, 2));
+    let (e0, e1, e2) = (pack_edge::<I>(&p1, &p2), pack_edge::<I>(&p2, &p0), pack_edge::<I>(&p0, &p1));
+    finish_test([p0, p1, p2], [e0, e1, e2], ray.shear[2], R4::<I>::splat(t_max), pack.live)
+}
+
+/// Up to eight rays whose triangle tests share a permutation (the same axis becomes z), one
+/// per lane, for [`intersect_triangle_rays`].
+pub struct RayLanes<I: Isa> {
+    axes: [usize; 3],
+    /// Each ray's origin, permuted.
+    origin: [R8<I>; 3],
+    shear: [R8<I>; 3],
+}
+
+impl<I: Isa> RayLanes<I> {
+    /// `None` when the rays do not all turn the same axis into z (or there are more than
+    /// eight); lanes past the last ray repeat it.
+    #[inline(always)]
+    pub fn new(rays: &[Ray]) -> Option<Self> {
+        if rays.is_empty() || rays.len() > 8 {
+            return None;
+        }
+        let first = TriangleRay::new(&rays[0]);
+        let mut lanes = [[0.0; 8]; 6];
+        for lane in 0..8 {
+            let ray = &rays[lane.min(rays.len() - 1)];
+            let triangle_ray = TriangleRay::new(ray);
+            if triangle_ray.axis_z != first.axis_z {
+                return None;
+            }
+            let origin = permute(ray.origin, first.axis_z);
+            let shear = triangle_ray.shear;
+            for (values, value) in lanes.iter_mut().zip([origin.x, origin.y, origin.z, shear.x, shear.y, shear.z]) {
+                values[lane] = value;
+            }
+        }
+        let l = &lanes;
+        Some(RayLanes {
+            axes: match first.axis_z {
+                0 => [1, 2, 0],
+                1 => [2, 0, 1],
+                _ => [0, 1, 2],
+            },
+            origin: [R8::<I>::load(&l[0]), R8::<I>::load(&l[1]), R8::<I>::load(&l[2])],
+            shear: [R8::<I>::load(&l[3]), R8::<I>::load(&l[4]), R8::<I>::load(&l[5])],
+        })
+    }
+}
+
+/// Vertex `v` of triangle `triangle` of `pack`, relative to each ray's origin, permuted and
+/// sheared.
+#[inline(always)]
+fn rays_vertex<I: Isa>(pack: &TrianglePack, triangle: usize, rays: &RayLanes<I>, v: usize) -> [R8<I>; 3] {
+    let [kx, ky, kz] = rays.axes;
+    let corner = &pack.corners[v];
+    let qx = R8::<I>::splat(corner[kx][triangle]) - rays.origin[0];
+    let qy = R8::<I>::splat(corner[ky][triangle]) - rays.origin[1];
+    let qz = R8::<I>::splat(corner[kz][triangle]) - rays.origin[2];
+    [qx + rays.shear[0] * qz, qy + rays.shear[1] * qz, qz]
+}
+
+/// [`intersect_triangle`] of triangle `triangle` of `pack` against each ray of `rays`, the rays
+/// in lanes: the same operations in the same order as the one-ray test (and as
+/// [`intersect_pack`]), so each lane's hit is bit for bit that ray's. `t_max` is per ray.
+///
+/// A kernel: compile it only inside one (see `crate::simd`).
+#[inline(always)]
+pub fn intersect_triangle_rays<I: Isa>(
+    pack: &TrianglePack,
+    triangle: usize,
+    rays: &RayLanes<I>,
+    t_max: R8<I>,
+) -> RayHits<I> {
+    let (p0, p1, p2) = (rays_vertex(pack, triangle, rays, 0), rays_vertex(pack, triangle, rays, 1), rays_vertex(pack, triangle, rays, 2));
+    let (e0, e1, e2) = (
+        edge8::<I>(p1[0], p1[1], p2[0], p2[1]),
+        edge8::<I>(p2[0], p2[1], p0[0], p0[1]),
+        edge8::<I>(p0[0], p0[1], p1[0], p1[1]),
+    );
+    finish_test([p0, p1, p2], [e0, e1, e2], rays.shear[2], t_max, u32::MAX)
+}
+
+/// The watertight test's second half, shared by both lane layouts: from the vertices (moved,
+/// permuted and sheared in x and y) and the edge functions to the lanes hit in `(0, t_max]`,
+/// with the one-ray test's operations in its order. `live` masks lanes holding no triangle.
+#[inline(always)]
+fn finish_test<L: Lanes<Elem = Real>>(p: [[L; 3]; 3], e: [L; 3], shear_z: L, t_max: L, live: u32) -> LaneHits<L> {
+    let splat = L::splat;
+    let ([p0, p1, p2], [e0, e1, e2]) = (p, e);
+    let zero = splat(0.0);
+    let negative = e0.lt(zero).or(e1.lt(zero)).or(e2.lt(zero));
+    let positive = e0.gt(zero).or(e1.gt(zero)).or(e2.gt(zero));
+    let det = e0 + e1 + e2;
+    let (z0, z1, z2) = (p0[2] * shear_z, p1[2] * shear_z, p2[2] * shear_z);
+    let t_scaled = e0 * z0 + e1 * z1 + e2 * z2;
+    let in_front = det.gt(zero).and(t_scaled.gt(zero)).or(det.lt(zero).and(t_scaled.lt(zero)));
+    let inv_det = splat(1.0) / det;
+    let t = t_scaled * inv_det;
+    // Most packs are missed by every lane; the error bound below is only needed for the others.
+    let candidates = in_front.and_not(negative.and(positive)).and(t.le(t_max));
+    if candidates.bits() & live == 0 {
+        return LaneHits { lanes: 0, t, edges: [e0, e1, e2], inv_det };
+    }
+    let max3 = max_abs3::<L>;
+    let max_zt = max3(z0, z1, z2);
+    let max_unscaled_zt = max3(p0[2], p1[2], p2[2]);
+    let max_xt = max3(p0[0], p1[0], p2[0]);
+    let max_yt = max3(p0[1], p1[1], p2[1]);
+    let delta_z = splat(gamma(3)) * max_zt;
+    let delta_x = splat(gamma(5)) * (max_xt + max_unscaled_zt);
+    let delta_y = splat(gamma(5)) * (max_yt + max_unscaled_zt);
+    let delta_e = splat(2.0) * (splat(gamma(2)) * max_xt * max_yt + delta_y * max_xt + delta_x * max_yt);
+    let max_e = max3(e0, e1, e2);
+    let delta_t =
+        splat(3.0) * (splat(gamma(3)) * max_e * max_zt + delta_e * max_zt + delta_z * max_e) * inv_det.abs();
+    let hit = candidates.and_not(t.le(delta_t));
+    LaneHits { lanes: hit.bits() & live, t, edges: [e0, e1, e2], inv_det }
+}
+
+impl TrianglePack {
+    /// Bit per lane holding a triangle that can be hit.
+    pub fn live(&self) -> u32 {
+        self.live
+    }
+}
