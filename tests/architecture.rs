@@ -164,3 +164,126 @@ fn the_checker_sees_imports_it_must_refuse() {
     assert!(references("use super::integrator::Whitted;", true).is_empty());
     assert!(layer("compare") < layer("case") && layer("scene") < layer("render"));
 }
+
+/// A file's module path below the crate root (`src/grade/diagnose/decide.rs` → `grade`,
+/// `diagnose`, `decide`; a `mod.rs` names its folder), or `None` outside the library.
+fn module_path(src: &Path, file: &Path) -> Option<Vec<String>> {
+    module_of(src, file)?;
+    let relative = file.strip_prefix(src).expect("under src").with_extension("");
+    let mut path: Vec<String> = relative
+        .components()
+        .map(|c| c.as_os_str().to_string_lossy().into_owned())
+        .collect();
+    if path.last().is_some_and(|last| last == "mod") {
+        path.pop();
+    }
+    Some(path)
+}
+
+/// The paths a code line names through `crate::` or `super::`, resolved against the module
+/// `at` (one `{a, b::c}` group expanded), as segments: `super::score::judge` in `grade::diagnose`
+/// gives `grade`, `score`, `judge`.
+fn named_paths(line: &str, at: &[String]) -> Vec<Vec<String>> {
+    let is_word = |c: char| c.is_alphanumeric() || c == '_';
+    let mut found = Vec::new();
+    for (start, _) in line.match_indices("crate::").chain(line.match_indices("super::")) {
+        if line[..start].ends_with("super::") || line[..start].chars().last().is_some_and(is_word) {
+            continue;
+        }
+        let mut rest = &line[start..];
+        let mut base: Vec<String> = Vec::new();
+        if let Some(after) = rest.strip_prefix("crate::") {
+            rest = after;
+        } else {
+            base = at[..at.len().saturating_sub(1)].to_vec();
+            rest = &rest["super::".len()..];
+            while let Some(after) = rest.strip_prefix("super::") {
+                base.pop();
+                rest = after;
+            }
+        }
+        let words: String = rest.chars().take_while(|&c| is_word(c) || c == ':').collect();
+        let mut prefix = base.clone();
+        prefix.extend(words.split("::").filter(|w| !w.is_empty()).map(str::to_owned));
+        let group = rest[words.len()..]
+            .strip_prefix('{')
+            .map(|g| g.split('}').next().unwrap_or(""));
+        match group {
+            Some(group) => {
+                for item in group.split(',') {
+                    let mut path = prefix.clone();
+                    path.extend(
+                        item.trim()
+                            .split("::")
+                            .filter(|w| !w.is_empty() && w.chars().all(is_word))
+                            .map(str::to_owned),
+                    );
+                    found.push(path);
+                }
+            }
+            None => found.push(prefix),
+        }
+    }
+    found
+}
+
+#[test]
+fn no_two_files_of_a_module_import_each_other() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut files = Vec::new();
+    source_files(&src, &mut files);
+    let modules: Vec<(PathBuf, Vec<String>)> = files
+        .iter()
+        .filter_map(|file| Some((file.clone(), module_path(&src, file)?)))
+        .collect();
+    let known = |path: &[String]| modules.iter().any(|(_, m)| m.as_slice() == path);
+    // Sibling edges: `a` and `b` share a parent, and something in `a`'s subtree names something
+    // in `b`'s. A parent and its own children may use each other (they are one concept).
+    let mut edges: Vec<(Vec<String>, Vec<String>, String)> = Vec::new();
+    for (file, module) in &modules {
+        let text = fs::read_to_string(file).expect("readable");
+        let code = text.split("#[cfg(test)]").next().unwrap_or("");
+        for (number, line) in code_lines(code) {
+            for path in named_paths(line, module) {
+                let Some(target) = (1..=path.len()).rev().map(|n| &path[..n]).find(|p| known(p)) else {
+                    continue;
+                };
+                let common = module.iter().zip(target).take_while(|(a, b)| a == b).count();
+                if common < module.len() && common < target.len() {
+                    let (from, to) = (module[..=common].to_vec(), target[..=common].to_vec());
+                    edges.push((from, to, format!("{}:{number}", file.display())));
+                }
+            }
+        }
+    }
+    let mut circles = Vec::new();
+    for (from, to, at) in &edges {
+        if from < to
+            && let Some((_, _, back)) = edges.iter().find(|(f, t, _)| f == to && t == from)
+        {
+            circles.push(format!("{} <-> {} ({at}; {back})", from.join("::"), to.join("::")));
+        }
+    }
+    circles.dedup();
+    assert!(
+        circles.is_empty(),
+        "files of one module that import each other:\n{}",
+        circles.join("\n")
+    );
+}
+
+#[test]
+fn the_circle_checker_resolves_paths() {
+    let at: Vec<String> = ["grade", "diagnose", "decide"].map(str::to_owned).to_vec();
+    assert_eq!(
+        named_paths("use super::super::score::{judge, ImageResult};", &at),
+        [
+            ["grade", "score", "judge"].map(str::to_owned).to_vec(),
+            ["grade", "score", "ImageResult"].map(str::to_owned).to_vec(),
+        ]
+    );
+    assert_eq!(
+        named_paths("let x = crate::compare::diff(a);", &at),
+        [["compare", "diff"].map(str::to_owned).to_vec()]
+    );
+}

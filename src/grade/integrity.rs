@@ -14,7 +14,6 @@ use std::path::{Path, PathBuf};
 use image::RgbImage;
 
 use super::error::RubricError;
-use super::rubric::ImageSpec;
 use super::submission::read_png;
 use crate::located_toml::{Field, Table};
 use crate::named_enum::named_enum;
@@ -127,17 +126,16 @@ pub fn pixel_hash(picture: &RgbImage) -> u64 {
     hasher.finish()
 }
 
-/// The published reference images, by rubric file name, as pixel hashes. A file the folder does
-/// not have, or cannot decode, is simply not compared.
-pub fn published_hashes(integrity: &Integrity, images: &[ImageSpec]) -> HashMap<String, u64> {
+/// The published reference images of the rubric's `files`, by file name, as pixel hashes. A
+/// file the folder does not have, or cannot decode, is simply not compared.
+pub fn published_hashes<'a>(integrity: &Integrity, files: impl Iterator<Item = &'a str>) -> HashMap<String, u64> {
     let Some(dir) = &integrity.published else {
         return HashMap::new();
     };
-    images
-        .iter()
-        .filter_map(|spec| {
-            let submitted = read_png(&dir.join(&spec.file)).ok()?;
-            Some((spec.file.clone(), pixel_hash(&submitted.picture)))
+    files
+        .filter_map(|file| {
+            let submitted = read_png(&dir.join(file)).ok()?;
+            Some((file.to_owned(), pixel_hash(&submitted.picture)))
         })
         .collect()
 }

@@ -21,6 +21,7 @@
 //! ```
 
 mod diagnose;
+mod diagnosis;
 mod error;
 mod golden;
 mod html;
@@ -40,10 +41,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use rayon::prelude::*;
 
 use crate::progress::Progress;
-pub use diagnose::{
-    Closest, Confidence, Diagnosis, DiagnosisRun, FAILING_REDUCTION, MISTAKES_DIR, RMSE_REDUCTION, RenderDiagnosis,
-    Residual, UNEXPLAINED, explains, loses_points,
-};
+pub use diagnose::{FAILING_REDUCTION, MISTAKES_DIR, RMSE_REDUCTION, explains, loses_points};
+pub use diagnosis::{Closest, Confidence, Diagnosis, DiagnosisRun, RenderDiagnosis, Residual, UNEXPLAINED};
 pub use error::{GradeError, RubricError};
 pub use golden::{GoldenRender, Goldens, default_cache_dir, prepare_goldens};
 pub use integrity::{Integrity, LinkPolicy, PUBLISHED_COPY};
@@ -108,7 +107,7 @@ pub fn grade_class_diagnosing(
     // One task per image rather than per student, so that both cores stay busy to the end of a
     // small class.
     let per_student = rubric.images.len();
-    let published = integrity::published_hashes(&rubric.integrity, &rubric.images);
+    let published = integrity::published_hashes(&rubric.integrity, rubric.images.iter().map(|spec| spec.file.as_str()));
     progress.begin("grading", (folders.len() * per_student) as u64);
     // Images left per student, so that the last one to finish can say the student is done.
     let left: Vec<AtomicUsize> = folders.iter().map(|_| AtomicUsize::new(per_student)).collect();

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
-use super::diagnose::Diagnosis;
+use super::diagnosis::Diagnosis;
 use super::golden::GOLDEN_DIR;
 use super::integrity::{Integrity, PUBLISHED_COPY, pixel_hash, refuse_link};
 use super::outcome::Outcome;

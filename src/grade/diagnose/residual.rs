@@ -3,17 +3,8 @@
 //! 8-bit codes, pixel by pixel, or over blocks for speckled mistakes (acne), whose speckles an
 //! independent program draws in other places.
 
+use super::super::diagnosis::Residual;
 use image::RgbImage;
-use serde::Serialize;
-
-/// The failing fraction and RMSE of one picture against another.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct Residual {
-    /// Pixels (or blocks) with a channel more than the rubric's threshold away.
-    pub failing_fraction: f64,
-    /// Over every channel, in 8-bit codes.
-    pub rmse: f64,
-}
 
 /// Pixel by pixel. Both pictures have the same size (the caller checks).
 pub fn residual(expected: &RgbImage, actual: &RgbImage, threshold: f64) -> Residual {

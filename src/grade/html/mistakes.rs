@@ -5,7 +5,7 @@
 
 use std::fmt::Write as _;
 
-use super::super::diagnose::{Confidence, Diagnosis, UNEXPLAINED};
+use super::super::diagnosis::{Confidence, Diagnosis, UNEXPLAINED};
 use super::super::golden::GOLDEN_DIR;
 use super::super::report::{ClassReport, format_points, mistakes_of};
 use super::super::score::{ImageResult, StudentResult, percent};
