@@ -19,7 +19,7 @@ use rayon::prelude::*;
 
 use goldray::case::{Case, LoadOptions, load};
 use goldray::film::{Film, Tonemap, color_image, encode_exr, write_png};
-use goldray::pipeline::render_case;
+use goldray::pipeline::{provenance, render_case};
 
 use comparator::{Judged, ToleranceComparator};
 
@@ -76,7 +76,13 @@ fn render(path: &Path) -> Result<Rendered, String> {
     }
     let case = load(path, &LoadOptions::default()).map_err(|e| e.to_string())?;
     let film = render_case(&case).map_err(|e| e.to_string())?;
-    let exr = encode_exr(&film).map_err(|e| format!("{}: {e}", shown(path)))?;
+    // The stable provenance only: a snapshot is compared by content, so the run's time and
+    // thread count would make every re-blessed golden differ from the last.
+    let made = provenance(&case).map_err(|e| e.to_string())?;
+    let exr = encode_exr(&film)
+        .map_err(|e| e.to_string())
+        .and_then(|bytes| made.stamp(&bytes, "the render").map_err(|e| e.to_string()))
+        .map_err(|e| format!("{}: {e}", shown(path)))?;
     Ok(Rendered { case, film, exr })
 }
 
@@ -125,11 +131,11 @@ fn check(rendered: &Rendered) -> Result<(), String> {
 
     let judged = judged.lock().map(|mut slot| slot.take()).unwrap_or(None);
     match (asserted, judged) {
-        (Ok(()), Some(Judged::Compared(comparison))) if !comparison.verdict.accepts() => {
+        (Ok(()), Some(Judged::Compared(comparison, _))) if !comparison.verdict.accepts() => {
             eprintln!("rewrote the golden of case {name} (INSTA_UPDATE); it differed by:\n{comparison}");
             Ok(())
         }
-        (Ok(()), Some(Judged::Compared(comparison)))
+        (Ok(()), Some(Judged::Compared(comparison, _)))
             if comparison.metrics.as_ref().is_some_and(|m| m.failing_pixels > 0) =>
         {
             eprintln!("warning: case {name} is within tolerance but some pixels moved:\n{comparison}");
@@ -168,10 +174,12 @@ fn failure_message(case: &Case, golden: &Path, judged: Option<Judged>) -> String
         Some(Judged::Unreadable(message)) => {
             format!("case {name} ({case_file}): {message}\n  if the new render ({preview}) is right, {accept}")
         }
-        Some(Judged::Compared(comparison)) => {
+        Some(Judged::Compared(comparison, made_differently)) => {
+            let made_differently = made_differently.map(|line| format!("made differently: {line}\n  "));
             format!(
-                "case {name} ({case_file}): {comparison}  if the change is intended, compare {preview} with its \
-                 .expected.png, then {accept}"
+                "case {name} ({case_file}): {}{comparison}  if the change is intended, compare {preview} with its \
+                 .expected.png, then {accept}",
+                made_differently.unwrap_or_default()
             )
         }
     }

@@ -12,10 +12,13 @@ use insta::{Comparator, Snapshot};
 
 use goldray::compare::{Comparison, Image, Tolerance, Verdict, compare, diff_heatmap};
 use goldray::film::write_png;
+use goldray::provenance::{Provenance, made_differently};
 
 /// What the comparator made of a snapshot pair.
 pub enum Judged {
-    Compared(Box<Comparison>),
+    /// The comparison, and how the golden and the render were made differently, if they were
+    /// ([`made_differently`]: the golden's settings or case may have changed since it was blessed).
+    Compared(Box<Comparison>, Option<String>),
     /// The golden (or the new render) could not be decoded; the message says which and why.
     Unreadable(String),
 }
@@ -47,6 +50,14 @@ impl ToleranceComparator {
     }
 
     fn judge(&self, reference: &Snapshot, test: &Snapshot) -> Judged {
+        let made = |contents: &SnapshotContents| match contents {
+            SnapshotContents::Binary(Some(bytes)) => Provenance::from_bytes(bytes, "snapshot").ok().flatten(),
+            _ => None,
+        };
+        let made_differently = made_differently(
+            ("golden", made(reference.contents()).as_ref()),
+            ("this render", made(test.contents()).as_ref()),
+        );
         let golden = match reference.contents() {
             SnapshotContents::Binary(Some(bytes)) => Image::from_exr_bytes(bytes, &self.golden_exr),
             _ => {
@@ -61,7 +72,7 @@ impl ToleranceComparator {
             _ => return Judged::Unreadable("the new render has no EXR data".to_owned()),
         };
         match (golden, render) {
-            (Ok(golden), Ok(render)) => Judged::Compared(Box::new(self.report(&golden, &render))),
+            (Ok(golden), Ok(render)) => Judged::Compared(Box::new(self.report(&golden, &render)), made_differently),
             (Err(e), _) | (_, Err(e)) => Judged::Unreadable(e.to_string()),
         }
     }
@@ -90,7 +101,7 @@ impl ToleranceComparator {
 impl Comparator for ToleranceComparator {
     fn matches(&self, reference: &Snapshot, test: &Snapshot) -> bool {
         let judged = self.judge(reference, test);
-        let accepted = matches!(&judged, Judged::Compared(c) if c.verdict.accepts());
+        let accepted = matches!(&judged, Judged::Compared(c, _) if c.verdict.accepts());
         if let Ok(mut slot) = self.judged.lock() {
             *slot = Some(judged);
         }
