@@ -20,6 +20,7 @@ use rayon::prelude::*;
 use goldray::case::{Case, LoadOptions, load};
 use goldray::film::{Film, Tonemap, color_image, encode_exr, write_png};
 use goldray::pipeline::{provenance, render_case};
+use goldray::provenance::{Group, strip};
 
 use comparator::{Judged, ToleranceComparator};
 
@@ -214,4 +215,48 @@ fn orphan_goldens(case_files: &[PathBuf]) -> Vec<String> {
 /// insta's own reading of `CI`, so the message matches what insta did.
 fn is_ci() -> bool {
     !matches!(std::env::var("CI").as_deref(), Err(_) | Ok("" | "0" | "false"))
+}
+
+/// A failure says how the golden and the render were made differently, before the verdict: here
+/// a golden of `jitter` with seed 7 against a render with seed 8 (the case file unchanged).
+#[test]
+fn a_failure_names_how_the_golden_and_the_render_were_made_differently() {
+    let mut case = load(&cases_dir().join("jitter.toml"), &LoadOptions::default()).expect("loads");
+    let stamped = |case: &Case| {
+        let film = render_case(case).expect("renders");
+        provenance(case)
+            .expect("provenance")
+            .stamp(&encode_exr(&film).expect("encodes"), "jitter")
+            .expect("stamps")
+    };
+    let golden = stamped(&case);
+    case.render.trace.seed = 8;
+    let render = stamped(&case);
+    // Its pictures go to a folder of its own, not beside the suite's.
+    let pictures = tempfile::tempdir().expect("tempdir");
+    let comparator = ToleranceComparator::new(
+        &case.name,
+        &case.tolerance,
+        Path::new("jitter.snap.exr"),
+        pictures.path(),
+    );
+    let judged = comparator.judge_bytes(Some(&golden), Some(&render));
+    assert!(
+        matches!(&judged, Judged::Compared(c, _) if !c.verdict.accepts()),
+        "seed 8 fails seed 7's golden"
+    );
+    let message = failure_message(&case, Path::new("golden/jitter.snap"), Some(judged));
+    assert!(
+        message.contains("made differently: golden: seed 7, 16 spp; this render: seed 8, 16 spp\n  FAIL"),
+        "{message}"
+    );
+
+    // A golden blessed before provenance: the render's side is summarised.
+    let unstamped = strip(&golden, Group::All).expect("strips");
+    let judged = comparator.judge_bytes(Some(&unstamped), Some(&render));
+    let message = failure_message(&case, Path::new("golden/jitter.snap"), Some(judged));
+    assert!(
+        message.contains("made differently: golden: no provenance; this render: jitter.toml, 128x128, seed 8, 16 spp"),
+        "{message}"
+    );
 }

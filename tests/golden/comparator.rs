@@ -50,28 +50,37 @@ impl ToleranceComparator {
     }
 
     fn judge(&self, reference: &Snapshot, test: &Snapshot) -> Judged {
-        let made = |contents: &SnapshotContents| match contents {
-            SnapshotContents::Binary(Some(bytes)) => Provenance::from_bytes(bytes, "snapshot").ok().flatten(),
+        let bytes = |contents: &'_ SnapshotContents| match contents {
+            SnapshotContents::Binary(Some(bytes)) => Some(bytes.to_vec()),
             _ => None,
         };
+        self.judge_bytes(
+            bytes(reference.contents()).as_deref(),
+            bytes(test.contents()).as_deref(),
+        )
+    }
+
+    /// Judges the golden EXR's bytes against the render's (`None`: a snapshot without them).
+    pub fn judge_bytes(&self, golden: Option<&[u8]>, render: Option<&[u8]>) -> Judged {
+        let made =
+            |bytes: Option<&[u8]>| bytes.and_then(|bytes| Provenance::from_bytes(bytes, "snapshot").ok().flatten());
         let made_differently = made_differently(
-            ("golden", made(reference.contents()).as_ref()),
-            ("this render", made(test.contents()).as_ref()),
+            ("golden", made(golden).as_ref()),
+            ("this render", made(render).as_ref()),
         );
-        let golden = match reference.contents() {
-            SnapshotContents::Binary(Some(bytes)) => Image::from_exr_bytes(bytes, &self.golden_exr),
-            _ => {
-                return Judged::Unreadable(format!(
-                    "{} is missing (its .snap is there): restore it from git, or bless the case again",
-                    self.golden_exr.display()
-                ));
-            }
+        let Some(golden) = golden else {
+            return Judged::Unreadable(format!(
+                "{} is missing (its .snap is there): restore it from git, or bless the case again",
+                self.golden_exr.display()
+            ));
         };
-        let render = match test.contents() {
-            SnapshotContents::Binary(Some(bytes)) => Image::from_exr_bytes(bytes, "this render"),
-            _ => return Judged::Unreadable("the new render has no EXR data".to_owned()),
+        let Some(render) = render else {
+            return Judged::Unreadable("the new render has no EXR data".to_owned());
         };
-        match (golden, render) {
+        match (
+            Image::from_exr_bytes(golden, &self.golden_exr),
+            Image::from_exr_bytes(render, "this render"),
+        ) {
             (Ok(golden), Ok(render)) => Judged::Compared(Box::new(self.report(&golden, &render)), made_differently),
             (Err(e), _) | (_, Err(e)) => Judged::Unreadable(e.to_string()),
         }
