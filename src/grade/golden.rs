@@ -10,6 +10,7 @@
 //! grade every student against the wrong picture.
 
 use std::collections::HashMap;
+use std::collections::hash_map::Entry;
 use std::fs;
 use std::hash::{DefaultHasher, Hash, Hasher};
 use std::path::{Path, PathBuf};
@@ -172,16 +173,18 @@ fn provenance_of<'a>(
     index: usize,
     known: &'a mut HashMap<usize, Provenance>,
 ) -> Result<&'a Provenance, GradeError> {
-    if !known.contains_key(&index) {
-        let source = &rubric.renders[index];
-        let made = provenance(&source.case).map_err(|error| GradeError::Golden {
-            location: source.location.clone(),
-            render: source.name.clone(),
-            source: Box::new(error),
-        })?;
-        known.insert(index, made);
+    match known.entry(index) {
+        Entry::Occupied(found) => Ok(found.into_mut()),
+        Entry::Vacant(slot) => {
+            let source = &rubric.renders[index];
+            let made = provenance(&source.case).map_err(|error| GradeError::Golden {
+                location: source.location.clone(),
+                render: source.name.clone(),
+                source: Box::new(error),
+            })?;
+            Ok(slot.insert(made))
+        }
     }
-    Ok(&known[&index])
 }
 
 fn store(path: &Path, film: &Film, provenance: &Provenance) -> Result<(), String> {

@@ -3,9 +3,11 @@
 
 use super::{Provenance, RUN_PREFIX, keys};
 
-/// The stable entries in the order they are named, each with how its value reads and what a
-/// missing one is called.
-const FIELDS: [(&str, fn(&str) -> String, &str); 13] = [
+/// A stable entry: its name, how its value reads, and what a missing one is called.
+type Field = (&'static str, fn(&str) -> String, &'static str);
+
+/// The stable entries in the order they are named.
+const FIELDS: [Field; 13] = [
     (keys::VERSION, |v| format!("goldray {v}"), "version"),
     (keys::COMMIT, |v| format!("commit {}", short_commit(v)), "commit"),
     (keys::CASE, |v| format!("case {v}"), "case name"),

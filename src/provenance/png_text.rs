@@ -8,8 +8,11 @@ use super::{Group, ProvenanceError};
 
 const SIGNATURE: usize = 8;
 
-/// Each chunk of the file after the signature: its type, its data and its whole span.
-fn chunks(bytes: &[u8], file: &str) -> Result<Vec<([u8; 4], (usize, usize))>, ProvenanceError> {
+/// A chunk's type and where its bytes (length to CRC) start and end.
+type Chunk = ([u8; 4], (usize, usize));
+
+/// Each chunk of the file after the signature.
+fn chunks(bytes: &[u8], file: &str) -> Result<Vec<Chunk>, ProvenanceError> {
     let mut found = Vec::new();
     let mut at = SIGNATURE;
     while at < bytes.len() {
@@ -34,7 +37,7 @@ fn chunks(bytes: &[u8], file: &str) -> Result<Vec<([u8; 4], (usize, usize))>, Pr
 
 /// The keyword of a text chunk (`tEXt`, `zTXt`, `iTXt` all start with it), or `None` for any
 /// other chunk.
-fn keyword<'a>(bytes: &'a [u8], kind: [u8; 4], span: (usize, usize)) -> Option<&'a [u8]> {
+fn keyword(bytes: &[u8], kind: [u8; 4], span: (usize, usize)) -> Option<&[u8]> {
     if !matches!(&kind, b"tEXt" | b"zTXt" | b"iTXt") {
         return None;
     }
