@@ -173,6 +173,25 @@ fn diff_names_a_changed_seed_before_its_verdict() {
             "{report}"
         );
     }
+
+    let json = goldray(&[
+        "diff",
+        seven.join("out/tiny.exr").to_str().unwrap(),
+        eight.join("out/tiny.exr").to_str().unwrap(),
+        "--json",
+    ]);
+    let text = String::from_utf8_lossy(&json.stdout);
+    assert!(text.starts_with("{\n  \"verdict\""), "the verdict stays first:\n{text}");
+    let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let provenance = &json["provenance"];
+    assert_eq!(provenance["expected"][keys::SEED], "7");
+    assert_eq!(provenance["actual"][keys::SEED], "8");
+    assert!(
+        provenance["made_differently"]
+            .as_str()
+            .is_some_and(|line| line.ends_with("seed 8, 4 spp")),
+        "{provenance}"
+    );
 }
 
 #[test]
