@@ -7,6 +7,7 @@ use rayon::prelude::*;
 
 use crate::atomic_write::write_file_atomic;
 use crate::film::{Film, OutputError, Tonemap, color_image, depth_image, encode_exr, encode_png, normals_image};
+use crate::provenance::Provenance;
 
 /// Encodes one output file.
 type Encode<'a> = Box<dyn Fn() -> Result<Vec<u8>, OutputError> + Sync + 'a>;
@@ -29,8 +30,10 @@ impl AssignmentOutputs {
     }
 
     /// Encodes every file before writing any, so a film that cannot be encoded writes nothing;
-    /// each file is then replaced atomically. The files are encoded in parallel.
-    pub fn write(&self, film: &Film) -> Result<Vec<PathBuf>, OutputError> {
+    /// each file is then replaced atomically. The files are encoded in parallel, and each
+    /// carries `provenance`: the course binary's PNGs carry no text chunks, but nothing that
+    /// compares against them reads more than their pixels.
+    pub fn write(&self, film: &Film, provenance: &Provenance) -> Result<Vec<PathBuf>, OutputError> {
         let tonemap = Tonemap::Clamp;
         let mut jobs: Vec<(&Path, Encode)> = Vec::new();
         if let Some(path) = &self.color {
@@ -50,7 +53,10 @@ impl AssignmentOutputs {
         }
         let files = jobs
             .par_iter()
-            .map(|(path, encode)| Ok((*path, encode()?)))
+            .map(|(path, encode)| {
+                let file = path.display().to_string();
+                Ok((*path, provenance.stamp(&encode()?, &file)?))
+            })
             .collect::<Result<Vec<(&Path, Vec<u8>)>, OutputError>>()?;
         // Each file is synced before it replaces its target; syncing them side by side lets the
         // file system commit them together rather than one after another.

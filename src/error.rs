@@ -3,6 +3,7 @@
 use crate::build_error::BuildError;
 use crate::case::CaseError;
 use crate::film::OutputError;
+use crate::provenance::ProvenanceError;
 
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
@@ -12,4 +13,6 @@ pub enum Error {
     Build(#[from] BuildError),
     #[error(transparent)]
     Output(#[from] OutputError),
+    #[error(transparent)]
+    Provenance(#[from] ProvenanceError),
 }

@@ -21,6 +21,7 @@ pub mod options;
 pub mod pipeline;
 pub mod precision;
 pub mod progress;
+pub mod provenance;
 pub mod simd;
 pub mod stats;
 pub mod tradeoff;

@@ -17,6 +17,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("options", 2),
     ("fault", 2),
     ("stats", 2),
+    ("provenance", 2),
     ("precision", 3),
     ("real", 3),
     ("geometry", 4),

@@ -11,6 +11,7 @@ use goldray::atomic_write::{AtomicWriteError, write_file_atomic};
 use goldray::film::{
     Film, OutputError, OutputOptions, Tonemap, decode_exr, encode_exr, read_exr, write_exr, write_outputs,
 };
+use goldray::provenance::{Group, Provenance, keys, strip};
 
 /// A non-square film (height not a multiple of the 16-line ZIP block) with values that a lossy or
 /// half-float path would change: tiny, huge, negative, negative zero, and misses.
@@ -223,7 +224,8 @@ fn write_outputs_writes_exactly_the_requested_files_in_order() {
     let dir = tempfile::tempdir().expect("tempdir");
     let out = dir.path().join("out");
     let film = varied_film(7);
-    let written = write_outputs(&out, "scene", &film, &all_options()).expect("write");
+    let provenance = Provenance::this_build().with(keys::SEED, 7);
+    let written = write_outputs(&out, "scene", &film, &all_options(), &provenance).expect("write");
     let expected: Vec<PathBuf> = ["scene.exr", "scene.png", "scene_depth.png", "scene_normals.png"]
         .iter()
         .map(|name| out.join(name))
@@ -233,7 +235,21 @@ fn write_outputs_writes_exactly_the_requested_files_in_order() {
         dir_entries(&out),
         names(&["scene.exr", "scene.png", "scene_depth.png", "scene_normals.png"])
     );
-    assert_eq!(fs::read(&expected[0]).expect("exr"), encode_exr(&film).expect("encode"));
+    let exr = fs::read(&expected[0]).expect("exr");
+    assert_eq!(
+        strip(&exr, Group::All).expect("strip"),
+        encode_exr(&film).expect("encode")
+    );
+    assert_eq!(
+        exr,
+        provenance
+            .stamp(&encode_exr(&film).expect("encode"), "scene.exr")
+            .expect("stamp")
+    );
+    for file in &expected {
+        let found = Provenance::read(file).expect("readable").expect("stamped");
+        assert_eq!(found, provenance, "{}", file.display());
+    }
     let png = image::open(&expected[1]).expect("png").to_rgb8();
     assert_eq!(png, goldray::film::color_image(&film, Tonemap::Srgb));
 
@@ -242,7 +258,7 @@ fn write_outputs_writes_exactly_the_requested_files_in_order() {
         depth_range: None,
         normals: false,
     };
-    let written = write_outputs(&out, "bare", &film, &bare).expect("write");
+    let written = write_outputs(&out, "bare", &film, &bare, &Provenance::default()).expect("write");
     assert_eq!(written, vec![out.join("bare.exr"), out.join("bare.png")]);
     assert_eq!(dir_entries(&out).len(), 6);
 }
@@ -251,8 +267,8 @@ fn write_outputs_writes_exactly_the_requested_files_in_order() {
 fn write_outputs_replaces_existing_files() {
     let dir = tempfile::tempdir().expect("tempdir");
     let (old, new) = (varied_film(8), varied_film(9));
-    write_outputs(dir.path(), "a", &old, &all_options()).expect("first");
-    write_outputs(dir.path(), "a", &new, &all_options()).expect("second");
+    write_outputs(dir.path(), "a", &old, &all_options(), &Provenance::default()).expect("first");
+    write_outputs(dir.path(), "a", &new, &all_options(), &Provenance::default()).expect("second");
     assert_eq!(bits(&read_exr(&dir.path().join("a.exr")).expect("read")), bits(&new));
     assert_eq!(dir_entries(dir.path()).len(), 4, "no temp files left");
 }
@@ -263,12 +279,26 @@ fn a_failed_write_leaves_existing_outputs_untouched_and_no_temp_files() {
     // A directory where an output should go makes that rename fail: first, middle and last.
     for blocked in all {
         let dir = tempfile::tempdir().expect("tempdir");
-        write_outputs(dir.path(), "a", &varied_film(10), &all_options()).expect("first");
+        write_outputs(
+            dir.path(),
+            "a",
+            &varied_film(10),
+            &all_options(),
+            &Provenance::default(),
+        )
+        .expect("first");
         fs::remove_file(dir.path().join(blocked)).expect("remove");
         fs::create_dir(dir.path().join(blocked)).expect("block");
         let before: Vec<Option<Vec<u8>>> = all.iter().map(|f| fs::read(dir.path().join(f)).ok()).collect();
 
-        let error = write_outputs(dir.path(), "a", &varied_film(11), &all_options()).expect_err("blocked output");
+        let error = write_outputs(
+            dir.path(),
+            "a",
+            &varied_film(11),
+            &all_options(),
+            &Provenance::default(),
+        )
+        .expect_err("blocked output");
         assert!(
             matches!(error, OutputError::Write(AtomicWriteError::Write { .. })),
             "{error}"
@@ -294,7 +324,14 @@ fn an_unwritable_directory_is_an_error_naming_it() {
     let dir = tempfile::tempdir().expect("tempdir");
     let not_a_dir = dir.path().join("file");
     fs::write(&not_a_dir, b"keep").expect("file");
-    let error = write_outputs(&not_a_dir, "a", &varied_film(12), &all_options()).expect_err("not a directory");
+    let error = write_outputs(
+        &not_a_dir,
+        "a",
+        &varied_film(12),
+        &all_options(),
+        &Provenance::default(),
+    )
+    .expect_err("not a directory");
     assert!(
         error
             .to_string()
@@ -308,7 +345,7 @@ fn a_refused_film_writes_nothing() {
     let dir = tempfile::tempdir().expect("tempdir");
     let mut film = varied_film(13);
     film.color[0][0] = f32::NAN;
-    let error = write_outputs(dir.path(), "a", &film, &all_options()).expect_err("NaN");
+    let error = write_outputs(dir.path(), "a", &film, &all_options(), &Provenance::default()).expect_err("NaN");
     let exr = dir.path().join("a.exr");
     assert!(matches!(error, OutputError::NonFinite { .. }));
     assert!(

@@ -19,7 +19,8 @@ use rayon::prelude::*;
 
 use goldray::case::{Case, LoadOptions, load};
 use goldray::film::{Film, Tonemap, color_image, encode_exr, write_png};
-use goldray::pipeline::render_case;
+use goldray::pipeline::{provenance, render_case};
+use goldray::provenance::{Group, strip};
 
 use comparator::{Judged, ToleranceComparator};
 
@@ -76,7 +77,13 @@ fn render(path: &Path) -> Result<Rendered, String> {
     }
     let case = load(path, &LoadOptions::default()).map_err(|e| e.to_string())?;
     let film = render_case(&case).map_err(|e| e.to_string())?;
-    let exr = encode_exr(&film).map_err(|e| format!("{}: {e}", shown(path)))?;
+    // The stable provenance only: a snapshot is compared by content, so the run's time and
+    // thread count would make every re-blessed golden differ from the last.
+    let made = provenance(&case).map_err(|e| e.to_string())?;
+    let exr = encode_exr(&film)
+        .map_err(|e| e.to_string())
+        .and_then(|bytes| made.stamp(&bytes, "the render").map_err(|e| e.to_string()))
+        .map_err(|e| format!("{}: {e}", shown(path)))?;
     Ok(Rendered { case, film, exr })
 }
 
@@ -125,11 +132,11 @@ fn check(rendered: &Rendered) -> Result<(), String> {
 
     let judged = judged.lock().map(|mut slot| slot.take()).unwrap_or(None);
     match (asserted, judged) {
-        (Ok(()), Some(Judged::Compared(comparison))) if !comparison.verdict.accepts() => {
+        (Ok(()), Some(Judged::Compared(comparison, _))) if !comparison.verdict.accepts() => {
             eprintln!("rewrote the golden of case {name} (INSTA_UPDATE); it differed by:\n{comparison}");
             Ok(())
         }
-        (Ok(()), Some(Judged::Compared(comparison)))
+        (Ok(()), Some(Judged::Compared(comparison, _)))
             if comparison.metrics.as_ref().is_some_and(|m| m.failing_pixels > 0) =>
         {
             eprintln!("warning: case {name} is within tolerance but some pixels moved:\n{comparison}");
@@ -168,10 +175,12 @@ fn failure_message(case: &Case, golden: &Path, judged: Option<Judged>) -> String
         Some(Judged::Unreadable(message)) => {
             format!("case {name} ({case_file}): {message}\n  if the new render ({preview}) is right, {accept}")
         }
-        Some(Judged::Compared(comparison)) => {
+        Some(Judged::Compared(comparison, made_differently)) => {
+            let made_differently = made_differently.map(|line| format!("made differently: {line}\n  "));
             format!(
-                "case {name} ({case_file}): {comparison}  if the change is intended, compare {preview} with its \
-                 .expected.png, then {accept}"
+                "case {name} ({case_file}): {}{comparison}  if the change is intended, compare {preview} with its \
+                 .expected.png, then {accept}",
+                made_differently.unwrap_or_default()
             )
         }
     }
@@ -206,4 +215,48 @@ fn orphan_goldens(case_files: &[PathBuf]) -> Vec<String> {
 /// insta's own reading of `CI`, so the message matches what insta did.
 fn is_ci() -> bool {
     !matches!(std::env::var("CI").as_deref(), Err(_) | Ok("" | "0" | "false"))
+}
+
+/// A failure says how the golden and the render were made differently, before the verdict: here
+/// a golden of `jitter` with seed 7 against a render with seed 8 (the case file unchanged).
+#[test]
+fn a_failure_names_how_the_golden_and_the_render_were_made_differently() {
+    let mut case = load(&cases_dir().join("jitter.toml"), &LoadOptions::default()).expect("loads");
+    let stamped = |case: &Case| {
+        let film = render_case(case).expect("renders");
+        provenance(case)
+            .expect("provenance")
+            .stamp(&encode_exr(&film).expect("encodes"), "jitter")
+            .expect("stamps")
+    };
+    let golden = stamped(&case);
+    case.render.trace.seed = 8;
+    let render = stamped(&case);
+    // Its pictures go to a folder of its own, not beside the suite's.
+    let pictures = tempfile::tempdir().expect("tempdir");
+    let comparator = ToleranceComparator::new(
+        &case.name,
+        &case.tolerance,
+        Path::new("jitter.snap.exr"),
+        pictures.path(),
+    );
+    let judged = comparator.judge_bytes(Some(&golden), Some(&render));
+    assert!(
+        matches!(&judged, Judged::Compared(c, _) if !c.verdict.accepts()),
+        "seed 8 fails seed 7's golden"
+    );
+    let message = failure_message(&case, Path::new("golden/jitter.snap"), Some(judged));
+    assert!(
+        message.contains("made differently: golden: seed 7, 16 spp; this render: seed 8, 16 spp\n  FAIL"),
+        "{message}"
+    );
+
+    // A golden blessed before provenance: the render's side is summarised.
+    let unstamped = strip(&golden, Group::All).expect("strips");
+    let judged = comparator.judge_bytes(Some(&unstamped), Some(&render));
+    let message = failure_message(&case, Path::new("golden/jitter.snap"), Some(judged));
+    assert!(
+        message.contains("made differently: golden: no provenance; this render: jitter.toml, 128x128, seed 8, 16 spp"),
+        "{message}"
+    );
 }

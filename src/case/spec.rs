@@ -27,6 +27,36 @@ pub struct Case {
     pub objects: Vec<ObjectSpec>,
 }
 
+impl Case {
+    /// Every file a render of this case reads besides the case itself, in a fixed order: the
+    /// OBJ meshes in object order, then the cube map's PNG faces by name. The grading cache and
+    /// each output's provenance hash them, so that changing a mesh changes both.
+    pub fn assets(&self) -> Vec<PathBuf> {
+        fn meshes(objects: &[ObjectSpec], out: &mut Vec<PathBuf>) {
+            for object in objects {
+                match &object.shape {
+                    ShapeSpec::Mesh { obj } => out.push(obj.clone()),
+                    ShapeSpec::Group { objects } => meshes(objects, out),
+                    ShapeSpec::Sphere { .. } | ShapeSpec::Plane { .. } | ShapeSpec::Triangle { .. } => {}
+                }
+            }
+        }
+        let mut files = Vec::new();
+        meshes(&self.objects, &mut files);
+        if let Some(dir) = &self.background.cube_map
+            && let Ok(entries) = std::fs::read_dir(dir)
+        {
+            let mut faces: Vec<PathBuf> = entries
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|x| x.eq_ignore_ascii_case("png")))
+                .collect();
+            faces.sort();
+            files.extend(faces);
+        }
+        files
+    }
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct RenderSettings {
     pub trace: Trace,

@@ -1,11 +1,13 @@
 //! `goldray diff`: the golden comparison from the shell, for any two EXR or PNG files, with
-//! idiff's exit codes so that scripts written for OpenImageIO keep working.
+//! idiff's exit codes so that scripts written for OpenImageIO keep working. Before the verdict
+//! it says how the two files were made differently, when their provenance says so.
 
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use goldray::compare::{ToleranceOverrides, compare_files};
+use goldray::provenance::{Provenance, made_differently};
 
 use super::common::{parse_fraction, parse_threshold};
 
@@ -67,10 +69,15 @@ pub fn run(args: DiffArgs) -> ExitCode {
     };
     let heatmap = args.diff_image.as_ref().map(|path| compared.write_heatmap(path));
     let comparison = &compared.comparison;
+    // Both files were just decoded, so reading their headers again cannot fail in a way that
+    // matters: a provenance that cannot be read is reported as none.
+    let [expected, actual] = [&args.expected, &args.actual].map(|path| Provenance::read(path).ok().flatten());
+    let differently = made_differently(("expected", expected.as_ref()), ("actual", actual.as_ref()));
     print_stdout(&if args.json {
-        comparison.to_json() + "\n"
+        with_provenance(&comparison.to_json(), [&expected, &actual], differently.as_deref()) + "\n"
     } else {
-        comparison.to_string()
+        let line = differently.map(|line| format!("made differently: {line}\n"));
+        line.unwrap_or_default() + &comparison.to_string()
     });
     match heatmap {
         Some(Err(error)) => {
@@ -82,6 +89,29 @@ pub fn run(args: DiffArgs) -> ExitCode {
             ExitCode::from(comparison.verdict.exit_code())
         }
         Some(Ok(true)) | None => ExitCode::from(comparison.verdict.exit_code()),
+    }
+}
+
+/// The comparison's JSON with a `provenance` object last: each file's `goldray.*` entries (or
+/// `null`) and the `made_differently` line (or `null`). Spliced into the text so that the
+/// report keeps its key order, the verdict first.
+fn with_provenance(json: &str, [expected, actual]: [&Option<Provenance>; 2], differently: Option<&str>) -> String {
+    let entries = |made: &Option<Provenance>| {
+        made.as_ref().map(|made| {
+            made.entries()
+                .map(|(k, v)| (k.to_owned(), serde_json::Value::from(v)))
+                .collect::<serde_json::Map<_, _>>()
+        })
+    };
+    let provenance = serde_json::json!({
+        "expected": entries(expected),
+        "actual": entries(actual),
+        "made_differently": differently,
+    });
+    let provenance = format!("{provenance:#}").replace('\n', "\n  ");
+    match json.trim_end().strip_suffix('}') {
+        Some(body) => format!("{},\n  \"provenance\": {provenance}\n}}", body.trim_end()),
+        None => json.to_owned(),
     }
 }
 

@@ -4,6 +4,7 @@ use std::io;
 use std::path::PathBuf;
 
 use crate::atomic_write::AtomicWriteError;
+use crate::provenance::ProvenanceError;
 
 /// Why an output could not be written or an EXR could not be read. Each message names the file
 /// (or "EXR data"/"PNG data" for in-memory bytes) and what went wrong, because these errors end up
@@ -12,6 +13,9 @@ use crate::atomic_write::AtomicWriteError;
 pub enum OutputError {
     #[error(transparent)]
     Write(#[from] AtomicWriteError),
+
+    #[error(transparent)]
+    Provenance(#[from] ProvenanceError),
 
     #[error("cannot read {}: {source}", path.display())]
     Read { path: PathBuf, source: io::Error },

@@ -11,6 +11,7 @@ use super::exr::encode_exr_named;
 use super::png::{color_image, depth_image, encode_png_named, normals_image};
 use super::{Film, Tonemap};
 use crate::atomic_write::write_files_atomic;
+use crate::provenance::Provenance;
 
 /// Which previews accompany the EXR; the EXR itself is always written because it is what golden
 /// comparisons read.
@@ -22,7 +23,8 @@ pub struct OutputOptions {
 }
 
 /// Writes `NAME.exr`, `NAME.png` and the requested `NAME_depth.png` / `NAME_normals.png` into
-/// `dir` (created if missing) and returns their paths in that order.
+/// `dir` (created if missing) and returns their paths in that order. Each file carries
+/// `provenance` (EXR header attributes, PNG text chunks).
 ///
 /// Everything is encoded before anything touches the disk, so a film the EXR refuses writes
 /// nothing. Files are then staged in a hidden directory inside `dir` and renamed into place one by
@@ -33,13 +35,15 @@ pub fn write_outputs(
     name: &str,
     film: &Film,
     options: &OutputOptions,
+    provenance: &Provenance,
 ) -> Result<Vec<PathBuf>, OutputError> {
     if name.is_empty() || Path::new(name).file_name() != Some(name.as_ref()) {
         return Err(OutputError::InvalidName { name: name.to_owned() });
     }
     let path = |suffix: &str| dir.join(format!("{name}{suffix}"));
     let png = |path: PathBuf, image: &dyn Fn() -> RgbImage| -> Result<(PathBuf, Vec<u8>), OutputError> {
-        let bytes = encode_png_named(&image(), &path.display().to_string())?;
+        let file = path.display().to_string();
+        let bytes = provenance.stamp(&encode_png_named(&image(), &file)?, &file)?;
         Ok((path, bytes))
     };
 
@@ -60,7 +64,11 @@ pub fn write_outputs(
         jobs.into_par_iter().map(|(path, image)| png(path, &*image)).collect()
     };
     let exr_path = path(".exr");
-    let (exr, previews) = rayon::join(|| encode_exr_named(film, &exr_path.display().to_string()), previews);
+    let exr = || -> Result<Vec<u8>, OutputError> {
+        let file = exr_path.display().to_string();
+        Ok(provenance.stamp(&encode_exr_named(film, &file)?, &file)?)
+    };
+    let (exr, previews) = rayon::join(exr, previews);
     let mut files = vec![(exr_path.clone(), exr?)];
     files.extend(previews?);
 
@@ -90,7 +98,13 @@ mod tests {
             normals: false,
         };
         for name in ["", "..", "a/b", "/abs"] {
-            let result = write_outputs(Path::new("unused"), name, &Film::new(1, 1), &options);
+            let result = write_outputs(
+                Path::new("unused"),
+                name,
+                &Film::new(1, 1),
+                &options,
+                &Provenance::default(),
+            );
             assert!(matches!(result, Err(OutputError::InvalidName { .. })), "{name:?}");
         }
         assert!(!Path::new("unused").exists());

@@ -10,6 +10,7 @@
 //! grade every student against the wrong picture.
 
 use std::collections::HashMap;
+use std::collections::hash_map::Entry;
 use std::fs;
 use std::hash::{DefaultHasher, Hash, Hasher};
 use std::path::{Path, PathBuf};
@@ -22,11 +23,12 @@ use serde::Serialize;
 use super::error::GradeError;
 use super::rubric::{Output, Rubric};
 use crate::atomic_write::write_file_atomic;
-use crate::case::{Case, ObjectSpec, ShapeSpec};
+use crate::case::Case;
 use crate::compare::Image;
-use crate::film::{Film, color_image, decode_exr, depth_image, encode_exr, normals_image, write_png};
-use crate::pipeline::render_case_reporting;
+use crate::film::{Film, OutputError, color_image, decode_exr, depth_image, encode_exr, encode_png, normals_image};
+use crate::pipeline::{provenance, render_case_reporting};
 use crate::progress::Progress;
+use crate::provenance::Provenance;
 
 /// Where the report keeps the golden PNGs, relative to the report directory.
 pub const GOLDEN_DIR: &str = "golden";
@@ -81,6 +83,7 @@ pub fn prepare_goldens(
     let mut films: HashMap<usize, Arc<Film>> = HashMap::new();
     let mut keys: HashMap<usize, String> = HashMap::new();
     let mut by_key: HashMap<String, usize> = HashMap::new();
+    let mut provenances: HashMap<usize, Provenance> = HashMap::new();
     let mut renders = Vec::new();
     for spec in &rubric.images {
         let index = spec.render_index;
@@ -110,7 +113,7 @@ pub fn prepare_goldens(
                     render: source.name.clone(),
                     source: Box::new(source_error),
                 })?;
-                let note = store(&path, &film).err();
+                let note = store(&path, &film, provenance_of(rubric, index, &mut provenances)?).err();
                 (film, false, note)
             }
         };
@@ -140,7 +143,11 @@ pub fn prepare_goldens(
             Output::Depth { min, max } => depth_image(film, min as f32, max as f32, tonemap),
         };
         let path = report_dir.join(GOLDEN_DIR).join(&spec.file);
-        write_png(&path, &picture)?;
+        write_golden_png(
+            &path,
+            &picture,
+            provenance_of(rubric, spec.render_index, &mut provenances)?,
+        )?;
         images.push(Image::from_rgb8(picture, path));
     }
     Ok(Goldens {
@@ -159,9 +166,39 @@ fn read_cached(path: &Path, case: &Case) -> Option<Film> {
     (film.width == case.render.trace.width && film.height == case.render.trace.height).then_some(film)
 }
 
-fn store(path: &Path, film: &Film) -> Result<(), String> {
+/// The provenance of the rubric's render `index`, computed once per run (it hashes the case and
+/// its assets): the stable group only, as cached and report files are compared by content.
+fn provenance_of<'a>(
+    rubric: &Rubric,
+    index: usize,
+    known: &'a mut HashMap<usize, Provenance>,
+) -> Result<&'a Provenance, GradeError> {
+    match known.entry(index) {
+        Entry::Occupied(found) => Ok(found.into_mut()),
+        Entry::Vacant(slot) => {
+            let source = &rubric.renders[index];
+            let made = provenance(&source.case).map_err(|error| GradeError::Golden {
+                location: source.location.clone(),
+                render: source.name.clone(),
+                source: Box::new(error),
+            })?;
+            Ok(slot.insert(made))
+        }
+    }
+}
+
+fn store(path: &Path, film: &Film, provenance: &Provenance) -> Result<(), String> {
+    let file = path.display().to_string();
     let bytes = encode_exr(film).map_err(|e| e.to_string())?;
+    let bytes = provenance.stamp(&bytes, &file).map_err(|e| e.to_string())?;
     write_file_atomic(path, &bytes).map_err(|e| e.to_string())
+}
+
+/// A golden picture of the report, with the provenance of its render.
+fn write_golden_png(path: &Path, picture: &RgbImage, provenance: &Provenance) -> Result<(), OutputError> {
+    let file = path.display().to_string();
+    let bytes = provenance.stamp(&encode_png(picture)?, &file)?;
+    Ok(write_file_atomic(path, &bytes)?)
 }
 
 /// 16 hex digits naming a render's pixels (see the module documentation). Assets that cannot be
@@ -171,7 +208,7 @@ pub fn cache_key(case: &Case) -> String {
     env!("CARGO_PKG_VERSION").hash(&mut hasher);
     build_identity().hash(&mut hasher);
     format!("{case:?}").hash(&mut hasher);
-    for asset in assets(case) {
+    for asset in case.assets() {
         asset.hash(&mut hasher);
         fs::read(&asset).ok().hash(&mut hasher);
     }
@@ -186,30 +223,4 @@ fn build_identity() -> u64 {
         std::env::current_exe().and_then(fs::read).ok().hash(&mut hasher);
         hasher.finish()
     })
-}
-
-/// Every file the render reads besides the case: OBJ meshes and the cube map's PNG faces.
-fn assets(case: &Case) -> Vec<PathBuf> {
-    fn meshes(objects: &[ObjectSpec], out: &mut Vec<PathBuf>) {
-        for object in objects {
-            match &object.shape {
-                ShapeSpec::Mesh { obj } => out.push(obj.clone()),
-                ShapeSpec::Group { objects } => meshes(objects, out),
-                ShapeSpec::Sphere { .. } | ShapeSpec::Plane { .. } | ShapeSpec::Triangle { .. } => {}
-            }
-        }
-    }
-    let mut files = Vec::new();
-    meshes(&case.objects, &mut files);
-    if let Some(dir) = &case.background.cube_map
-        && let Ok(entries) = fs::read_dir(dir)
-    {
-        let mut faces: Vec<PathBuf> = entries
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter(|p| p.extension().is_some_and(|x| x.eq_ignore_ascii_case("png")))
-            .collect();
-        faces.sort();
-        files.extend(faces);
-    }
-    files
 }

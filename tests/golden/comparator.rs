@@ -12,10 +12,13 @@ use insta::{Comparator, Snapshot};
 
 use goldray::compare::{Comparison, Image, Tolerance, Verdict, compare, diff_heatmap};
 use goldray::film::write_png;
+use goldray::provenance::{Provenance, made_differently};
 
 /// What the comparator made of a snapshot pair.
 pub enum Judged {
-    Compared(Box<Comparison>),
+    /// The comparison, and how the golden and the render were made differently, if they were
+    /// ([`made_differently`]: the golden's settings or case may have changed since it was blessed).
+    Compared(Box<Comparison>, Option<String>),
     /// The golden (or the new render) could not be decoded; the message says which and why.
     Unreadable(String),
 }
@@ -47,21 +50,38 @@ impl ToleranceComparator {
     }
 
     fn judge(&self, reference: &Snapshot, test: &Snapshot) -> Judged {
-        let golden = match reference.contents() {
-            SnapshotContents::Binary(Some(bytes)) => Image::from_exr_bytes(bytes, &self.golden_exr),
-            _ => {
-                return Judged::Unreadable(format!(
-                    "{} is missing (its .snap is there): restore it from git, or bless the case again",
-                    self.golden_exr.display()
-                ));
-            }
+        let bytes = |contents: &'_ SnapshotContents| match contents {
+            SnapshotContents::Binary(Some(bytes)) => Some(bytes.to_vec()),
+            _ => None,
         };
-        let render = match test.contents() {
-            SnapshotContents::Binary(Some(bytes)) => Image::from_exr_bytes(bytes, "this render"),
-            _ => return Judged::Unreadable("the new render has no EXR data".to_owned()),
+        self.judge_bytes(
+            bytes(reference.contents()).as_deref(),
+            bytes(test.contents()).as_deref(),
+        )
+    }
+
+    /// Judges the golden EXR's bytes against the render's (`None`: a snapshot without them).
+    pub fn judge_bytes(&self, golden: Option<&[u8]>, render: Option<&[u8]>) -> Judged {
+        let made =
+            |bytes: Option<&[u8]>| bytes.and_then(|bytes| Provenance::from_bytes(bytes, "snapshot").ok().flatten());
+        let made_differently = made_differently(
+            ("golden", made(golden).as_ref()),
+            ("this render", made(render).as_ref()),
+        );
+        let Some(golden) = golden else {
+            return Judged::Unreadable(format!(
+                "{} is missing (its .snap is there): restore it from git, or bless the case again",
+                self.golden_exr.display()
+            ));
         };
-        match (golden, render) {
-            (Ok(golden), Ok(render)) => Judged::Compared(Box::new(self.report(&golden, &render))),
+        let Some(render) = render else {
+            return Judged::Unreadable("the new render has no EXR data".to_owned());
+        };
+        match (
+            Image::from_exr_bytes(golden, &self.golden_exr),
+            Image::from_exr_bytes(render, "this render"),
+        ) {
+            (Ok(golden), Ok(render)) => Judged::Compared(Box::new(self.report(&golden, &render)), made_differently),
             (Err(e), _) | (_, Err(e)) => Judged::Unreadable(e.to_string()),
         }
     }
@@ -90,7 +110,7 @@ impl ToleranceComparator {
 impl Comparator for ToleranceComparator {
     fn matches(&self, reference: &Snapshot, test: &Snapshot) -> bool {
         let judged = self.judge(reference, test);
-        let accepted = matches!(&judged, Judged::Compared(c) if c.verdict.accepts());
+        let accepted = matches!(&judged, Judged::Compared(c, _) if c.verdict.accepts());
         if let Ok(mut slot) = self.judged.lock() {
             *slot = Some(judged);
         }
