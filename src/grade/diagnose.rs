@@ -33,10 +33,10 @@ use std::time::Instant;
 
 use image::RgbImage;
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::error::GradeError;
-use super::golden::Goldens;
+use super::golden::{CacheMode, Goldens};
 use super::outcome::Outcome;
 use super::rubric::{ImageSpec, Output, Rubric, Rule};
 use super::score::{ImageResult, StudentResult, judge};
@@ -45,7 +45,6 @@ use crate::atomic_write::write_file_atomic;
 use crate::compare::{Image, Metrics, Tolerance, compare, diff_heatmap};
 use crate::fault::{Fault, FaultSet, Gamma, Parameter};
 use crate::film::{Picture, encode_png, picture_with_faults};
-use crate::progress::Progress;
 pub use residual::Residual;
 
 /// A fault explains an image only if the image fails at most this many times fewer pixels
@@ -71,7 +70,7 @@ pub const MISTAKES_DIR: &str = "mistakes";
 
 /// What explains an image that lost points. `grades.json` holds it per image, only for images
 /// that did not get full points.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Diagnosis {
     /// A catalogue id, two joined by `+`, or `unexplained`.
     pub id: String,
@@ -109,7 +108,7 @@ pub struct Diagnosis {
     pub ties: Vec<FaultSet>,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Confidence {
     /// The image passes against the mistake's picture and no other mistake comes close.
@@ -120,7 +119,7 @@ pub enum Confidence {
     None,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Closest {
     pub id: String,
     pub faults: String,
@@ -128,7 +127,7 @@ pub struct Closest {
 }
 
 /// What diagnosing a class cost, render by render, for `grades.json` and the summary.
-#[derive(Clone, Debug, Default, Serialize)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct DiagnosisRun {
     pub seconds: f64,
     /// Images that lost points, and how many of them a mistake explains.
@@ -137,7 +136,7 @@ pub struct DiagnosisRun {
     pub renders: Vec<RenderDiagnosis>,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct RenderDiagnosis {
     pub render: String,
     pub images: usize,
@@ -147,7 +146,7 @@ pub struct RenderDiagnosis {
     pub cached: usize,
     pub seconds: f64,
     /// Fault sets that could not be rendered, with the reason; left out of the comparison.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub failed: Vec<String>,
 }
 
@@ -266,192 +265,305 @@ impl Subject<'_> {
     }
 }
 
-/// Diagnoses every image of `students` that lost points, writes the mistakes' pictures and the
-/// residual heatmaps into `out`, and fills in each such image's [`Diagnosis`].
-pub(super) fn diagnose_class(
-    rubric: &Rubric,
-    goldens: &Goldens,
-    cache: &Path,
-    students: &mut [StudentResult],
-    out: &Path,
-    progress: &dyn Progress,
-) -> Result<DiagnosisRun, GradeError> {
-    let started = Instant::now();
-    let mut run = DiagnosisRun::default();
-    // Images grouped by golden render (two rubric renders with the same content are one).
+/// Where diagnosis finds (and may keep) the mistakes' pictures, and the mistake pictures already
+/// written into the report by this run.
+pub(super) struct Diagnoser<'a> {
+    rubric: &'a Rubric,
+    goldens: &'a Goldens,
+    cache: &'a Path,
+    cache_mode: CacheMode,
+    out: &'a Path,
+    written: Mutex<HashSet<PathBuf>>,
+    run: Mutex<DiagnosisRun>,
+}
+
+impl<'a> Diagnoser<'a> {
+    pub fn new(rubric: &'a Rubric, goldens: &'a Goldens, cache: &'a Path, cache_mode: CacheMode, out: &'a Path) -> Self {
+        Diagnoser {
+            rubric,
+            goldens,
+            cache,
+            cache_mode,
+            out,
+            written: Mutex::new(HashSet::new()),
+            run: Mutex::new(DiagnosisRun::default()),
+        }
+    }
+
+    /// What this run's diagnosis cost, render by render.
+    pub fn run(self) -> DiagnosisRun {
+        self.run.into_inner().unwrap_or_else(|p| p.into_inner())
+    }
+
+    fn store<'b>(
+        &self,
+        key: &str,
+        case: &'b crate::case::Case,
+        film: &'b crate::film::Film,
+        pictures: Vec<Picture>,
+        stored: Vec<Picture>,
+    ) -> pictures::FaultPictures<'b> {
+        pictures::FaultPictures::new(
+            Some(self.cache.join("faults").join(key)),
+            self.cache_mode,
+            case,
+            film,
+            pictures,
+            stored,
+        )
+    }
+
+    /// Diagnoses every image of `students` that lost points, writes the mistakes' pictures and
+    /// the residual heatmaps into the report, and fills in each such image's [`Diagnosis`]. A
+    /// student's diagnosis depends on that student's images alone (the fault sets tried beyond
+    /// the single mistakes are those the student's own images ask for), so that grading a class
+    /// in slices, or again after a few submissions changed, names the same mistakes.
+    pub fn diagnose(&self, students: &mut [StudentResult]) -> Result<(), GradeError> {
+        let (rubric, goldens, out) = (self.rubric, self.goldens, self.out);
+        let started = Instant::now();
+        let mut renders = Vec::new();
+        for (key, images) in render_groups(goldens) {
+            let failing: Vec<(usize, usize)> = students
+                .iter()
+                .enumerate()
+                .flat_map(|(s, student)| {
+                    images
+                        .iter()
+                        .filter(|&&i| loses_points(&student.images[i]))
+                        .map(move |&i| (s, i))
+                })
+                .collect();
+            if failing.is_empty() {
+                continue;
+            }
+            let render_started = Instant::now();
+            let source = &rubric.renders[rubric.images[images[0]].render_index];
+            // The pictures compared: those of the images that lost points; every picture of the
+            // render is cached, for the gradings to come.
+            let pictures = distinct_pictures(rubric, &mut failing.iter().map(|&(_, i)| i));
+            let stored = distinct_pictures(rubric, &mut images.iter().copied());
+            let film = goldens.films[images[0]].clone();
+            let store = self.store(key, &source.case, &film, pictures, stored);
+            // A fault set that cannot be rendered (it cannot, for the course's scenes) is left out
+            // and said in the run's record, rather than stopping the grading.
+            let failed = Mutex::new(Vec::new());
+            let get = |set: FaultSet| match store.get(&set) {
+                Ok(pictures) => Some(Candidate { set, pictures }),
+                Err(error) => {
+                    failed
+                        .lock()
+                        .unwrap_or_else(|p| p.into_inner())
+                        .push(format!("{set}: {error}"));
+                    None
+                }
+            };
+            let golden_pictures = store.golden();
+            // Where the golden primary rays hit nothing (the background shows).
+            let misses: Vec<bool> = store.golden_film().depth.iter().map(|t| *t == f32::INFINITY).collect();
+            // Read or rendered side by side: decoding cached pictures is most of a warm run's cost.
+            let singles: Vec<Candidate> = candidates::singles(&source.case, store.pictures())
+                .into_par_iter()
+                .filter_map(get)
+                .collect();
+
+            // The students' pictures and their singles' scores, in parallel.
+            let subjects: Vec<Option<Subject>> = failing
+                .par_iter()
+                .map(|&(s, i)| {
+                    let spec = &rubric.images[i];
+                    let index = store.pictures().iter().position(|p| *p == film_picture(spec.output))?;
+                    let file = students[s].images[i].graded_file.as_ref()?;
+                    let student = read_png(file).ok()?.picture;
+                    let golden = &golden_pictures[index];
+                    if student.dimensions() != golden.dimensions() {
+                        return None;
+                    }
+                    let block = residual::block_size(golden);
+                    Some(Subject {
+                        spec,
+                        picture: index,
+                        by_pixel: residual::residual(golden, &student, spec.rule.threshold),
+                        by_block: residual::block_residual(golden, &student, spec.rule.threshold, block),
+                        student,
+                        golden,
+                        block,
+                    })
+                })
+                .collect();
+            let scored: Vec<Vec<Scored>> = subjects
+                .par_iter()
+                .map(|subject| match subject {
+                    Some(subject) => singles.iter().filter_map(|c| subject.score(c)).collect(),
+                    None => Vec::new(),
+                })
+                .collect();
+
+            // What each student's images want tried next, rendered once for all of them.
+            let mut wanted: BTreeMap<usize, Vec<FaultSet>> = BTreeMap::new();
+            for ((subject, scores), &(s, _)) in subjects.iter().zip(&scored).zip(&failing) {
+                if let Some(subject) = subject {
+                    let background = fit_background(subject, &misses, &singles);
+                    let student_wants = wanted.entry(s).or_default();
+                    for set in expansions(&source.case, subject, scores, &singles)
+                        .into_iter()
+                        .chain(background)
+                    {
+                        if !student_wants.contains(&set) && !singles.iter().any(|c| c.set == set) {
+                            student_wants.push(set);
+                        }
+                    }
+                }
+            }
+            let mut all_wanted: Vec<FaultSet> = Vec::new();
+            for set in wanted.values().flatten() {
+                if !all_wanted.contains(set) {
+                    all_wanted.push(*set);
+                }
+            }
+            let fault_sets = singles.len() + all_wanted.len();
+            let expanded: Vec<Candidate> = all_wanted.into_par_iter().filter_map(get).collect();
+
+            let decided: Vec<Option<(Diagnosis, usize, usize)>> = failing
+                .par_iter()
+                .zip(subjects.par_iter().zip(scored.par_iter()))
+                .map(|(&(s, i), (subject, scores))| {
+                    let subject = subject.as_ref()?;
+                    let student_wants = wanted.get(&s).map_or(&[][..], Vec::as_slice);
+                    // In the order the student's images asked for them, whoever else asked.
+                    let expanded: Vec<&Candidate> = student_wants
+                        .iter()
+                        .filter_map(|set| expanded.iter().find(|c| c.set == *set))
+                        .collect();
+                    let mut scores = scores.clone();
+                    let known = |set: &FaultSet| singles.iter().chain(expanded.iter().copied()).find(|c| c.set == *set);
+                    // A pair that draws this picture as one of its faults alone does has no
+                    // evidence of the other.
+                    let adds_nothing = |c: &Candidate| {
+                        c.set.len() > 1
+                            && c.set.faults().any(|f| {
+                                known(&c.set.without(f))
+                                    .is_some_and(|m| m.pictures[subject.picture] == c.pictures[subject.picture])
+                            })
+                    };
+                    scores.extend(
+                        expanded
+                            .iter()
+                            .filter(|c| !adds_nothing(c))
+                            .filter_map(|c| subject.score(c)),
+                    );
+                    scores.extend(fit_gamma(subject, &store, &scores));
+                    let slug = student_dir(&students[s]);
+                    let diagnosis = decide(subject, &scores, &store, &expanded, &singles, out, &slug, &self.written);
+                    Some((diagnosis, s, i))
+                })
+                .collect();
+            let mut explained = 0;
+            for (diagnosis, s, i) in decided.into_iter().flatten() {
+                explained += usize::from(diagnosis.id != UNEXPLAINED);
+                students[s].images[i].diagnosis = Some(diagnosis);
+            }
+            renders.push((
+                failing.len(),
+                explained,
+                RenderDiagnosis {
+                    render: source.name.clone(),
+                    images: failing.len(),
+                    fault_sets,
+                    rendered: store.rendered.load(std::sync::atomic::Ordering::Relaxed),
+                    cached: store.cached.load(std::sync::atomic::Ordering::Relaxed),
+                    seconds: render_started.elapsed().as_secs_f64(),
+                    failed: failed.into_inner().unwrap_or_else(|p| p.into_inner()),
+                },
+            ));
+        }
+        let mut batch = DiagnosisRun {
+            seconds: started.elapsed().as_secs_f64(),
+            ..DiagnosisRun::default()
+        };
+        for (images, explained, render) in renders {
+            batch.images += images;
+            batch.explained += explained;
+            batch.renders.push(render);
+        }
+        self.run.lock().unwrap_or_else(|p| p.into_inner()).add(&batch);
+        Ok(())
+    }
+}
+
+/// Renders (or finds in `cache`) every single mistake's pictures of every render of the rubric and
+/// caches them, so that later gradings, and shards that only read the cache, find them there.
+/// Returns how many fault sets were rendered now.
+pub(super) fn prepare_mistakes(rubric: &Rubric, goldens: &Goldens, cache: &Path) -> usize {
+    let mut rendered = 0;
+    for (key, images) in render_groups(goldens) {
+        let source = &rubric.renders[rubric.images[images[0]].render_index];
+        let pictures = distinct_pictures(rubric, &mut images.iter().copied());
+        let film = goldens.films[images[0]].clone();
+        let store = pictures::FaultPictures::new(
+            Some(cache.join("faults").join(key)),
+            CacheMode::ReadWrite,
+            &source.case,
+            &film,
+            pictures.clone(),
+            pictures,
+        );
+        candidates::singles(&source.case, store.pictures())
+            .into_par_iter()
+            .for_each(|set| drop(store.get(&set)));
+        rendered += store.rendered.load(std::sync::atomic::Ordering::Relaxed);
+    }
+    rendered
+}
+
+impl DiagnosisRun {
+    /// Another batch's (or shard's) diagnosis added in.
+    pub fn add(&mut self, other: &DiagnosisRun) {
+        self.seconds += other.seconds;
+        self.images += other.images;
+        self.explained += other.explained;
+        for render in &other.renders {
+            match self.renders.iter_mut().find(|r| r.render == render.render) {
+                Some(known) => known.add(render.clone()),
+                None => self.renders.push(render.clone()),
+            }
+        }
+    }
+}
+
+impl RenderDiagnosis {
+    /// Another batch of students' diagnosis of the same render.
+    fn add(&mut self, other: RenderDiagnosis) {
+        self.images += other.images;
+        self.fault_sets = self.fault_sets.max(other.fault_sets);
+        self.rendered += other.rendered;
+        self.cached += other.cached;
+        self.seconds += other.seconds;
+        self.failed.extend(other.failed);
+    }
+}
+
+/// The rubric's images grouped by golden render (two rubric renders with the same content are
+/// one), in rubric order.
+fn render_groups(goldens: &Goldens) -> Vec<(&str, Vec<usize>)> {
     let mut groups: BTreeMap<&str, Vec<usize>> = BTreeMap::new();
     for (index, key) in goldens.keys.iter().enumerate() {
         groups.entry(key.as_str()).or_default().push(index);
     }
     let mut groups: Vec<(&str, Vec<usize>)> = groups.into_iter().collect();
     groups.sort_by_key(|(_, images)| images[0]);
-    let total: usize = students
-        .iter()
-        .map(|s| s.images.iter().filter(|i| loses_points(i)).count())
-        .sum();
-    run.images = total;
-    if total == 0 {
-        return Ok(run);
+    groups
+}
+
+/// The distinct film pictures of some of the rubric's images, in order of first use.
+fn distinct_pictures(rubric: &Rubric, images: &mut dyn Iterator<Item = usize>) -> Vec<Picture> {
+    let mut pictures: Vec<Picture> = Vec::new();
+    for i in images {
+        let picture = film_picture(rubric.images[i].output);
+        if !pictures.contains(&picture) {
+            pictures.push(picture);
+        }
     }
-    progress.begin("diagnosing", total as u64);
-    let written = Mutex::new(HashSet::new());
-    for (key, images) in groups {
-        let failing: Vec<(usize, usize)> = students
-            .iter()
-            .enumerate()
-            .flat_map(|(s, student)| {
-                images
-                    .iter()
-                    .filter(|&&i| loses_points(&student.images[i]))
-                    .map(move |&i| (s, i))
-            })
-            .collect();
-        if failing.is_empty() {
-            continue;
-        }
-        let render_started = Instant::now();
-        let source = &rubric.renders[rubric.images[images[0]].render_index];
-        progress.step(&format!("diagnosing images of {}", source.name));
-        // The pictures compared: those of the images that lost points; every picture of the
-        // render is cached, for the gradings to come.
-        let distinct = |images: &mut dyn Iterator<Item = usize>| {
-            let mut pictures: Vec<Picture> = Vec::new();
-            for i in images {
-                let picture = film_picture(rubric.images[i].output);
-                if !pictures.contains(&picture) {
-                    pictures.push(picture);
-                }
-            }
-            pictures
-        };
-        let pictures = distinct(&mut failing.iter().map(|&(_, i)| i));
-        let stored = distinct(&mut images.iter().copied());
-        let film = goldens.films[images[0]].clone();
-        let store = pictures::FaultPictures::new(
-            Some(cache.join("faults").join(key)),
-            &source.case,
-            &film,
-            pictures,
-            stored,
-        );
-        // A fault set that cannot be rendered (it cannot, for the course's scenes) is left out
-        // and said in the run's record, rather than stopping the grading.
-        let failed = Mutex::new(Vec::new());
-        let get = |set: FaultSet| match store.get(&set) {
-            Ok(pictures) => Some(Candidate { set, pictures }),
-            Err(error) => {
-                failed
-                    .lock()
-                    .unwrap_or_else(|p| p.into_inner())
-                    .push(format!("{set}: {error}"));
-                None
-            }
-        };
-        let golden_pictures = store.golden();
-        // Where the golden primary rays hit nothing (the background shows).
-        let misses: Vec<bool> = store.golden_film().depth.iter().map(|t| *t == f32::INFINITY).collect();
-        // Read or rendered side by side: decoding cached pictures is most of a warm run's cost.
-        let singles: Vec<Candidate> = candidates::singles(&source.case, store.pictures())
-            .into_par_iter()
-            .filter_map(get)
-            .collect();
-
-        // The students' pictures and their singles' scores, in parallel.
-        let subjects: Vec<Option<Subject>> = failing
-            .par_iter()
-            .map(|&(s, i)| {
-                let spec = &rubric.images[i];
-                let index = store.pictures().iter().position(|p| *p == film_picture(spec.output))?;
-                let file = students[s].images[i].graded_file.as_ref()?;
-                let student = read_png(file).ok()?.picture;
-                let golden = &golden_pictures[index];
-                if student.dimensions() != golden.dimensions() {
-                    return None;
-                }
-                let block = residual::block_size(golden);
-                Some(Subject {
-                    spec,
-                    picture: index,
-                    by_pixel: residual::residual(golden, &student, spec.rule.threshold),
-                    by_block: residual::block_residual(golden, &student, spec.rule.threshold, block),
-                    student,
-                    golden,
-                    block,
-                })
-            })
-            .collect();
-        let scored: Vec<Vec<Scored>> = subjects
-            .par_iter()
-            .map(|subject| match subject {
-                Some(subject) => singles.iter().filter_map(|c| subject.score(c)).collect(),
-                None => Vec::new(),
-            })
-            .collect();
-
-        // What each image wants tried next, rendered once for all of them.
-        let mut wanted: Vec<FaultSet> = Vec::new();
-        for (subject, scores) in subjects.iter().zip(&scored) {
-            if let Some(subject) = subject {
-                let background = fit_background(subject, &misses, &singles);
-                for set in expansions(&source.case, subject, scores, &singles)
-                    .into_iter()
-                    .chain(background)
-                {
-                    if !wanted.contains(&set) && !singles.iter().any(|c| c.set == set) {
-                        wanted.push(set);
-                    }
-                }
-            }
-        }
-        let expanded: Vec<Candidate> = wanted.into_par_iter().filter_map(get).collect();
-
-        let decided: Vec<Option<(Diagnosis, usize, usize)>> = failing
-            .par_iter()
-            .zip(subjects.par_iter().zip(scored.par_iter()))
-            .map(|(&(s, i), (subject, scores))| {
-                let subject = subject.as_ref()?;
-                let mut scores = scores.clone();
-                let known = |set: &FaultSet| singles.iter().chain(&expanded).find(|c| c.set == *set);
-                // A pair that draws this picture as one of its faults alone does has no evidence
-                // of the other.
-                let adds_nothing = |c: &Candidate| {
-                    c.set.len() > 1
-                        && c.set.faults().any(|f| {
-                            known(&c.set.without(f))
-                                .is_some_and(|m| m.pictures[subject.picture] == c.pictures[subject.picture])
-                        })
-                };
-                scores.extend(
-                    expanded
-                        .iter()
-                        .filter(|c| !adds_nothing(c))
-                        .filter_map(|c| subject.score(c)),
-                );
-                scores.extend(fit_gamma(subject, &store, &scores));
-                let slug = student_dir(&students[s]);
-                let diagnosis = decide(subject, &scores, &store, &expanded, &singles, out, &slug, &written);
-                progress.advance(1);
-                Some((diagnosis, s, i))
-            })
-            .collect();
-        for (diagnosis, s, i) in decided.into_iter().flatten() {
-            run.explained += usize::from(diagnosis.id != UNEXPLAINED);
-            students[s].images[i].diagnosis = Some(diagnosis);
-        }
-        let rendered = store.rendered.load(std::sync::atomic::Ordering::Relaxed);
-        run.renders.push(RenderDiagnosis {
-            render: source.name.clone(),
-            images: failing.len(),
-            fault_sets: singles.len() + expanded.len(),
-            rendered,
-            cached: store.cached.load(std::sync::atomic::Ordering::Relaxed),
-            seconds: render_started.elapsed().as_secs_f64(),
-            failed: failed.into_inner().unwrap_or_else(|p| p.into_inner()),
-        });
-    }
-    progress.finish();
-    run.seconds = started.elapsed().as_secs_f64();
-    Ok(run)
+    pictures
 }
 
 /// The id of an image no mistake explains.
@@ -627,7 +739,7 @@ fn decide(
     subject: &Subject,
     scores: &[Scored],
     store: &pictures::FaultPictures,
-    expanded: &[Candidate],
+    expanded: &[&Candidate],
     singles: &[Candidate],
     out: &Path,
     student_dir: &str,
@@ -656,7 +768,7 @@ fn decide(
     order.extend(rest);
     let picture_of = |set: &FaultSet| -> Option<RgbImage> {
         let index = subject.picture;
-        if let Some(candidate) = singles.iter().chain(expanded).find(|c| c.set == *set) {
+        if let Some(candidate) = singles.iter().chain(expanded.iter().copied()).find(|c| c.set == *set) {
             return Some(candidate.pictures[index].clone());
         }
         if let Some(known) = store.get_if_known(set) {

@@ -4,10 +4,10 @@
 //! independent program draws in other places.
 
 use image::RgbImage;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// The failing fraction and RMSE of one picture against another.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Residual {
     /// Pixels (or blocks) with a channel more than the rubric's threshold away.
     pub failing_fraction: f64,
