@@ -505,7 +505,10 @@ fn grades_json_has_a_diagnosis_exactly_where_points_were_lost() {
         }
     }
     assert!(diagnosed > 250);
-    assert!(json.get("diagnosis").is_none(), "what diagnosis cost is in run.json, not in the grades");
+    assert!(
+        json.get("diagnosis").is_none(),
+        "what diagnosis cost is in run.json, not in the grades"
+    );
     let run: serde_json::Value =
         serde_json::from_str(&fs::read_to_string(graded.dir.join("report/run.json")).unwrap()).unwrap();
     assert!(run["diagnosis"]["renders"].as_array().unwrap().len() == 7, "{run}");

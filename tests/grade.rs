@@ -14,6 +14,8 @@ mod cli;
 mod integrity;
 #[path = "grade/rubrics.rs"]
 mod rubrics;
+#[path = "grade/scale.rs"]
+mod scale;
 
 use std::collections::BTreeMap;
 use std::fs;

@@ -60,7 +60,8 @@ pub fn run(args: GradeArgs) -> Result<ExitCode, Failure> {
     if let Some(out) = &args.merge {
         if args.inputs.is_empty() {
             return Err(Failure::Usage(
-                "--merge OUT needs the shards' report folders after it: goldray grade --merge OUT SHARD_DIR...".to_owned(),
+                "--merge OUT needs the shards' report folders after it: goldray grade --merge OUT SHARD_DIR..."
+                    .to_owned(),
             ));
         }
         goldray::atomic_write::check_writable_folder(out)?;

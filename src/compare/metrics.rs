@@ -245,7 +245,6 @@ fn null_is_infinite<'de, D: Deserializer<'de>>(deserializer: D) -> Result<f64, D
     Ok(Option::<f64>::deserialize(deserializer)?.unwrap_or(f64::INFINITY))
 }
 
-
 fn worst_color(channels: &[ChannelStats]) -> Option<PixelError> {
     largest(
         channels

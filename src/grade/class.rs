@@ -84,8 +84,16 @@ pub(super) fn grade(
                     .map(|(spec, golden)| {
                         let mut timings = Timings::default();
                         let published = published.get(&spec.file).copied();
-                        grade_image(spec, golden, &submission, &rubric.integrity, published, out, &mut timings)
-                            .map(|result| (result, timings))
+                        grade_image(
+                            spec,
+                            golden,
+                            &submission,
+                            &rubric.integrity,
+                            published,
+                            out,
+                            &mut timings,
+                        )
+                        .map(|result| (result, timings))
                     })
                     .collect::<Result<Vec<_>, OutputError>>()?;
                 let mut timings = Timings::default();
@@ -93,7 +101,11 @@ pub(super) fn grade(
                     timings += *t;
                 }
                 let result = StudentResult::new(&submission, graded.into_iter().map(|(r, _)| r).collect());
-                Ok(Step::Graded { result, inputs, timings })
+                Ok(Step::Graded {
+                    result,
+                    inputs,
+                    timings,
+                })
             })
             .collect::<Result<Vec<Step>, GradeError>>()?;
 
@@ -105,7 +117,11 @@ pub(super) fn grade(
                     cost.reused += 1;
                     order.push(Err(record.into_result()));
                 }
-                Step::Graded { result, inputs, timings } => {
+                Step::Graded {
+                    result,
+                    inputs,
+                    timings,
+                } => {
                     order.push(Ok(fresh.len()));
                     fresh.push(result);
                     fresh_inputs.push(inputs);

@@ -278,7 +278,13 @@ pub(super) struct Diagnoser<'a> {
 }
 
 impl<'a> Diagnoser<'a> {
-    pub fn new(rubric: &'a Rubric, goldens: &'a Goldens, cache: &'a Path, cache_mode: CacheMode, out: &'a Path) -> Self {
+    pub fn new(
+        rubric: &'a Rubric,
+        goldens: &'a Goldens,
+        cache: &'a Path,
+        cache_mode: CacheMode,
+        out: &'a Path,
+    ) -> Self {
         Diagnoser {
             rubric,
             goldens,

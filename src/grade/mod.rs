@@ -49,13 +49,12 @@ pub use golden::{CacheMode, GoldenRender, Goldens, default_cache_dir, prepare_go
 pub use integrity::{Integrity, LinkPolicy, PUBLISHED_COPY};
 pub use outcome::Outcome;
 pub use report::{ClassReport, RubricSummary, diagnoses_of, flags, mistakes_of};
+pub use resume::{RESULT_FILE, StudentRecord};
 pub use rubric::{ImageSpec, Output, RenderSource, Rubric, Rule, load_rubric, parse_rubric};
 pub use score::{ImageResult, StudentResult, Submission, grade_image, judge};
-pub use resume::{RESULT_FILE, StudentRecord};
 pub use shard::{MANIFEST, Manifest, Shard, ShardError};
 pub use similarity::{NEAR_IDENTICAL, SimilarPair};
 pub use timing::{RunCost, Timings};
-
 
 /// Where the report and the golden cache go, which slice of the class to grade, and whether
 /// results kept from an earlier run may be reused.
@@ -161,9 +160,18 @@ pub fn summary(report: &ClassReport, out: &Path) -> String {
     let diagnosis = report.diagnosis.as_ref().map_or(String::new(), |run| {
         let renders: usize = run.renders.iter().map(|r| r.rendered).sum();
         let cached: usize = run.renders.iter().map(|r| r.cached).sum();
+        // Counted over the class: students kept from an earlier run keep their diagnoses.
+        let diagnosed: Vec<&Diagnosis> = report
+            .students
+            .iter()
+            .flat_map(|s| &s.images)
+            .filter_map(|i| i.diagnosis.as_ref())
+            .collect();
+        let explained = diagnosed.iter().filter(|d| d.id != UNEXPLAINED).count();
         format!(
-            "\ndiagnosed {} images that lost points: {} explained by a known mistake ({renders} mistake renders, {cached} cached, {:.1} s)",
-            run.images, run.explained, run.seconds
+            "\ndiagnosed {} images that lost points: {explained} explained by a known mistake ({renders} mistake renders, {cached} cached, {:.1} s)",
+            diagnosed.len(),
+            run.seconds
         )
     });
     format!(

@@ -13,8 +13,8 @@ use super::outcome::Outcome;
 use super::rubric::{ImageSpec, Rule};
 use super::similarity::Fingerprint;
 use super::submission::{Folder, read_png};
-use crate::atomic_write::write_file_atomic;
 use super::timing::{Timings, seconds, timed};
+use crate::atomic_write::write_file_atomic;
 use crate::compare::{Image, Metrics, Tolerance, compare_timed, diff_heatmap};
 use crate::film::{OutputError, encode_png, write_png};
 

@@ -137,8 +137,8 @@ pub fn read_shards(dirs: &[PathBuf]) -> Result<Vec<ShardOutput>, GradeError> {
                 path.display()
             ))
         })?;
-        let manifest: Manifest = serde_json::from_str(&text)
-            .map_err(|e| fail(format!("{}: not a shard manifest: {e}", path.display())))?;
+        let manifest: Manifest =
+            serde_json::from_str(&text).map_err(|e| fail(format!("{}: not a shard manifest: {e}", path.display())))?;
         shards.push((dir.clone(), manifest));
     }
     let (first_dir, first) = shards[0].clone();
@@ -168,7 +168,9 @@ pub fn read_shards(dirs: &[PathBuf]) -> Result<Vec<ShardOutput>, GradeError> {
             )));
         }
         if manifest.class != first.class {
-            return Err(differs("different class listings (the submissions folder changed between them)"));
+            return Err(differs(
+                "different class listings (the submissions folder changed between them)",
+            ));
         }
     }
     let count = first.shard.count;
@@ -228,7 +230,10 @@ pub fn read_shards(dirs: &[PathBuf]) -> Result<Vec<ShardOutput>, GradeError> {
 /// Copies a shard's pictures into the merged report: the golden pictures, the mistakes' pictures
 /// and each of its students' folder (their pictures, heatmaps and result).
 pub fn copy_pictures(shard: &ShardOutput, out: &Path) -> Result<(), OutputError> {
-    copy_tree(&shard.dir.join(super::golden::GOLDEN_DIR), &out.join(super::golden::GOLDEN_DIR))?;
+    copy_tree(
+        &shard.dir.join(super::golden::GOLDEN_DIR),
+        &out.join(super::golden::GOLDEN_DIR),
+    )?;
     copy_tree(
         &shard.dir.join(super::diagnose::MISTAKES_DIR),
         &out.join(super::diagnose::MISTAKES_DIR),
@@ -270,8 +275,14 @@ mod tests {
     fn shards_parse_and_say_what_is_wrong() {
         assert_eq!("2/7".parse(), Ok(Shard { index: 2, count: 7 }));
         assert_eq!("1/1".parse(), Ok(Shard::WHOLE));
-        assert_eq!("0/3".parse::<Shard>().unwrap_err().to_string(), "`0/3`: K must be between 1 and 3 (slices are counted from 1)");
-        assert!(matches!("4/3".parse::<Shard>(), Err(ShardError::Index { count: 3, .. })));
+        assert_eq!(
+            "0/3".parse::<Shard>().unwrap_err().to_string(),
+            "`0/3`: K must be between 1 and 3 (slices are counted from 1)"
+        );
+        assert!(matches!(
+            "4/3".parse::<Shard>(),
+            Err(ShardError::Index { count: 3, .. })
+        ));
         assert_eq!("1/0".parse::<Shard>(), Err(ShardError::Count("1/0".to_owned())));
         for bad in ["3", "a/b", "1/", "-1/3", "1/2/3"] {
             assert_eq!(bad.parse::<Shard>(), Err(ShardError::Form(bad.to_owned())), "{bad}");
@@ -282,14 +293,19 @@ mod tests {
     fn slices_cover_the_class_once_in_order() {
         for students in [0, 1, 5, 20, 101] {
             for count in [1, 2, 3, 7, 30] {
-                let ranges: Vec<Range<usize>> = (1..=count).map(|index| Shard { index, count }.range(students)).collect();
+                let ranges: Vec<Range<usize>> = (1..=count)
+                    .map(|index| Shard { index, count }.range(students))
+                    .collect();
                 assert_eq!(ranges[0].start, 0);
                 assert_eq!(ranges[count - 1].end, students);
                 for pair in ranges.windows(2) {
                     assert_eq!(pair[0].end, pair[1].start);
                 }
                 let sizes: Vec<usize> = ranges.iter().map(|r| r.len()).collect();
-                assert!(sizes.iter().max().unwrap() - sizes.iter().min().unwrap() <= 1, "{sizes:?}");
+                assert!(
+                    sizes.iter().max().unwrap() - sizes.iter().min().unwrap() <= 1,
+                    "{sizes:?}"
+                );
             }
         }
     }
