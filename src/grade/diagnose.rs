@@ -41,7 +41,7 @@ use super::outcome::Outcome;
 use super::rubric::{ImageSpec, Output, Rubric, Rule};
 use super::score::{ImageResult, StudentResult, judge};
 use super::submission::read_png;
-use crate::atomic_write::write_file_atomic;
+use crate::atomic_write::replace_file;
 use crate::compare::{Image, Metrics, Tolerance, compare, diff_heatmap};
 use crate::fault::{Fault, FaultSet, Gamma, Parameter};
 use crate::film::{Picture, encode_png, picture_with_faults};
@@ -937,11 +937,11 @@ fn write_pictures(
         .lock()
         .unwrap_or_else(|p| p.into_inner())
         .insert(absolute.clone());
-    let mistake_ok = !first || encode_png(mistake).is_ok_and(|bytes| write_file_atomic(&absolute, &bytes).is_ok());
+    let mistake_ok = !first || encode_png(mistake).is_ok_and(|bytes| replace_file(&absolute, &bytes).is_ok());
     let stem = file.strip_suffix(".png").unwrap_or(file);
     let residual_path = format!("{student_dir}/{stem}.mistake.png");
     let residual_ok = diff_heatmap(expected, student, subject.spec.rule.threshold).is_some_and(|heatmap| {
-        encode_png(&heatmap).is_ok_and(|bytes| write_file_atomic(&out.join(&residual_path), &bytes).is_ok())
+        encode_png(&heatmap).is_ok_and(|bytes| replace_file(&out.join(&residual_path), &bytes).is_ok())
     });
     (mistake_ok.then_some(mistake_path), residual_ok.then_some(residual_path))
 }

@@ -211,7 +211,7 @@ pub fn time_spent(cost: &RunCost) -> String {
     if cost.graded > 0 {
         let each = cost.timings.per(cost.graded);
         text.push_str(&format!(
-            "; per graded student {:.2} s: decode {:.2} s, compare {:.2} s, FLIP {:.2} s, diagnosis {:.2} s, report {:.2} s",
+            "; per graded student {:.3} s: decode {:.3} s, compare {:.3} s, FLIP {:.3} s, diagnosis {:.3} s, report {:.3} s",
             each.total(),
             each.decode,
             each.compare,

@@ -26,7 +26,7 @@ use super::rubric::Rubric;
 use super::score::{StudentResult, Submission};
 use super::similarity::Fingerprint;
 use super::timing::Timings;
-use crate::atomic_write::write_file_atomic;
+use crate::atomic_write::replace_file;
 use crate::film::OutputError;
 
 /// The file a student's result is kept in, inside the student's folder of the report.
@@ -79,12 +79,14 @@ pub fn read_record(out: &Path, slug: &str, images: usize) -> Option<StudentRecor
     (record.result.images.len() == images && record.fingerprints.len() == images).then_some(record)
 }
 
-/// Writes the record atomically: a reader sees the old file or the whole new one.
+/// Writes the record atomically: a reader sees the old file or the whole new one. Not synced
+/// (a class writes one per student): after a power failure a record may be missing or damaged,
+/// and is then not trusted, which only costs grading that student again.
 pub fn write_record(out: &Path, slug: &str, record: &StudentRecord) -> Result<(), OutputError> {
     // Serialising plain data cannot fail; infinite numbers (PSNR) become null and read back as
     // infinite.
     let json = serde_json::to_string(record).unwrap_or_default();
-    write_file_atomic(&out.join(record_path(slug)), json.as_bytes())?;
+    replace_file(&out.join(record_path(slug)), json.as_bytes())?;
     Ok(())
 }
 

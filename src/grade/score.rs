@@ -14,9 +14,9 @@ use super::rubric::{ImageSpec, Rule};
 use super::similarity::Fingerprint;
 use super::submission::{Folder, read_png};
 use super::timing::{Timings, seconds, timed};
-use crate::atomic_write::write_file_atomic;
+use crate::atomic_write::replace_file;
 use crate::compare::{Image, Metrics, Tolerance, compare_timed, diff_heatmap};
-use crate::film::{OutputError, encode_png, write_png};
+use crate::film::{OutputError, encode_png};
 
 /// One expected file of one student.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -180,7 +180,7 @@ pub fn grade_image(
     let Some(metrics) = comparison.metrics else {
         // Both pictures are 8-bit RGB, so only their sizes can keep them from being compared.
         timed(&mut timings.report, || -> Result<(), OutputError> {
-            Ok(write_file_atomic(&out.join(&copy), &encode_png(&actual.preview)?)?)
+            Ok(replace_file(&out.join(&copy), &encode_png(&actual.preview)?)?)
         })?;
         result.student_image = Some(copy);
         let outcome = Outcome::WrongSize {
@@ -200,15 +200,15 @@ pub fn grade_image(
     } else if outcome == Outcome::Pass {
         // Full points: a thumbnail shows what was handed in; there is nothing for the student to
         // find in a full-size copy or a heatmap, and a class that passes keeps a small report.
-        write_file_atomic(&out.join(&copy), &encode_png(&thumbnail(&actual.preview))?)?;
+        replace_file(&out.join(&copy), &encode_png(&thumbnail(&actual.preview))?)?;
         result.student_image = Some(copy);
     } else {
-        write_file_atomic(&out.join(&copy), &encode_png(&actual.preview)?)?;
+        replace_file(&out.join(&copy), &encode_png(&actual.preview)?)?;
         result.student_image = Some(copy);
         if let Some(heatmap) = diff_heatmap(golden, &actual, spec.rule.threshold) {
             let stem = spec.file.strip_suffix(".png").unwrap_or(&spec.file);
             let diff = format!("{dir}/{stem}.diff.png");
-            write_png(&out.join(&diff), &heatmap)?;
+            replace_file(&out.join(&diff), &encode_png(&heatmap)?)?;
             result.diff_image = Some(diff);
         }
     }

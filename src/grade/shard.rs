@@ -23,7 +23,7 @@ use super::golden::GoldenRender;
 use super::report::RubricSummary;
 use super::resume::{StudentRecord, read_record};
 use super::timing::RunCost;
-use crate::atomic_write::write_file_atomic;
+use crate::atomic_write::{replace_file, write_file_atomic};
 use crate::film::OutputError;
 
 /// The manifest every grading run writes into its report folder.
@@ -259,7 +259,7 @@ fn copy_tree(from: &Path, to: &Path) -> Result<(), OutputError> {
                     path: source.clone(),
                     source: e,
                 })?;
-                write_file_atomic(&target, &bytes)?;
+                replace_file(&target, &bytes)?;
             }
             _ => {}
         }
