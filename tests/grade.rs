@@ -18,6 +18,8 @@ mod memory;
 mod rubrics;
 #[path = "grade/scale.rs"]
 mod scale;
+#[path = "grade/sched.rs"]
+mod sched;
 
 use std::collections::BTreeMap;
 use std::fs;
