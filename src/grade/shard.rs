@@ -193,8 +193,6 @@ pub fn read_shards(dirs: &[PathBuf]) -> Result<Vec<ShardOutput>, GradeError> {
         return Err(fail(format!("missing slice(s) {} of the class", missing.join(", "))));
     }
     let images = first.rubric.images.len();
-    let first_dir = &first_dir;
-    let _ = first_dir;
     shards
         .into_iter()
         .map(|(dir, manifest)| {

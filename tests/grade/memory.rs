@@ -51,6 +51,8 @@ fn class(dir: &Path, students: usize) -> std::path::PathBuf {
 
 /// Grades `submissions` on two threads and returns the process's peak resident memory in KiB.
 fn peak_kib(rubric: &Path, submissions: &Path, out: &Path, cache: &Path) -> i64 {
+    // Reaped by `wait4` below, which `Child::wait` cannot replace: it also returns the usage.
+    #[allow(clippy::zombie_processes)]
     let child = Command::new(env!("CARGO_BIN_EXE_goldray"))
         .args(["grade", "--quiet", "--threads", "2", "--rubric"])
         .args([rubric, submissions])
