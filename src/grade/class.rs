@@ -67,7 +67,9 @@ pub(super) fn grade(
             .par_iter()
             .map(|&i| {
                 let submission = Submission::new(names[i].clone(), folders[&names[i]].clone(), slugs[i].clone());
+                let hashing = Instant::now();
                 let inputs = student_fingerprint(&run, &submission, &rubric);
+                let hashing = hashing.elapsed().as_secs_f64();
                 if !options.force
                     && let Some(record) = read_record(out, &submission.slug, rubric.images.len())
                     && record.run == run
@@ -96,7 +98,11 @@ pub(super) fn grade(
                         .map(|result| (result, timings))
                     })
                     .collect::<Result<Vec<_>, OutputError>>()?;
-                let mut timings = Timings::default();
+                // Reading the files to fingerprint them counts as reading them.
+                let mut timings = Timings {
+                    decode: hashing,
+                    ..Timings::default()
+                };
                 for (_, t) in &graded {
                     timings += *t;
                 }

@@ -10,7 +10,8 @@ use serde::{Deserialize, Serialize};
 /// several threads at once, so on a multi-core machine the sum exceeds the wall-clock time.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Timings {
-    /// Reading and decoding the submitted PNGs (and hashing them for the copy checks).
+    /// Reading and decoding the submitted PNGs, and hashing them (for resuming and for the copy
+    /// checks).
     pub decode: f64,
     /// Comparing with the golden picture, FLIP excluded.
     pub compare: f64,

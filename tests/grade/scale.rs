@@ -271,6 +271,12 @@ fn a_rerun_resumes_regrading_only_what_changed_or_was_not_trusted() {
     };
     let (first, _) = grade(&out, &[]);
     assert!(first.contains("(10 students graded)"), "{first}");
+    for step in ["per graded student", "decode", "compare", "FLIP", "diagnosis", "report"] {
+        assert!(first.contains(step), "the summary says where the time went: {first}");
+    }
+    let run: serde_json::Value = serde_json::from_slice(&fs::read(out.join("run.json")).unwrap()).unwrap();
+    assert_eq!(run["graded"], 10, "{run}");
+    assert!(run["timings"]["flip"].as_f64().unwrap() > 0.0, "{run}");
 
     // One result deleted, one cut short, one student's picture replaced by another's.
     fs::remove_file(out.join("students/perfect/result.json")).unwrap();
