@@ -85,6 +85,7 @@ fn main() {
         let options = GradeOptions {
             out: dir.join(name),
             cache: Some(cache.clone()),
+            ..GradeOptions::default()
         };
         let started = Instant::now();
         let report = grade_class_diagnosing(&rubric_path, &submissions, &options, diagnose, &Silent)

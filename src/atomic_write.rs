@@ -6,6 +6,7 @@
 use std::fs::{self, File};
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Why a file could not be replaced. Messages name the file the caller asked for, never the
 /// temporary file beside it.
@@ -32,6 +33,35 @@ pub enum AtomicWriteError {
 /// which is then renamed over it. Creates the parent directory if missing.
 pub fn write_file_atomic(path: &Path, bytes: &[u8]) -> Result<(), AtomicWriteError> {
     write_files_atomic(parent_folder(path), &[(path, bytes)])
+}
+
+/// [`write_file_atomic`] without syncing: readers still see the old file or the whole new one
+/// (the bytes go to a temporary file beside `path`, renamed over it), but a power failure soon
+/// after may lose the new content. For outputs written by the hundred that are cheap to make
+/// again, and checked when read back (a report's per-student pictures, pages and results), where
+/// a sync per file would cost more than making the file.
+pub fn replace_file(path: &Path, bytes: &[u8]) -> Result<(), AtomicWriteError> {
+    let error = |source| AtomicWriteError::Write {
+        path: path.to_path_buf(),
+        source,
+    };
+    static NEXT: AtomicU64 = AtomicU64::new(0);
+    let dir = parent_folder(path);
+    fs::create_dir_all(dir).map_err(error)?;
+    // Created like any output (the umask decides who may read it), under a name no other
+    // writer in this or another process uses.
+    let temp = dir.join(format!(
+        ".goldray-{}-{}.tmp",
+        std::process::id(),
+        NEXT.fetch_add(1, Ordering::Relaxed)
+    ));
+    let written = File::create_new(&temp)
+        .and_then(|mut file| file.write_all(bytes))
+        .and_then(|()| fs::rename(&temp, path));
+    if written.is_err() {
+        let _ = fs::remove_file(&temp);
+    }
+    written.map_err(error)
 }
 
 /// Checks, before any work is spent on it, that `path` could be written: it is not a folder, and
@@ -187,6 +217,28 @@ fn write_synced(path: &Path, bytes: &[u8]) -> io::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn replace_file_replaces_whole_and_leaves_no_temporary_file() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let path = dir.path().join("sub/page.html");
+        replace_file(&path, b"first").expect("write");
+        replace_file(&path, b"second").expect("replace");
+        assert_eq!(fs::read(&path).expect("read"), b"second");
+        let left: Vec<_> = fs::read_dir(dir.path().join("sub")).expect("list").collect();
+        assert_eq!(left.len(), 1, "only the page: {left:?}");
+        fs::create_dir_all(dir.path().join("folder")).expect("folder");
+        let error = replace_file(&dir.path().join("folder"), b"x").unwrap_err().to_string();
+        assert!(
+            error.starts_with(&format!("cannot write {}", dir.path().join("folder").display())),
+            "{error}"
+        );
+        assert_eq!(
+            fs::read_dir(dir.path()).expect("list").count(),
+            2,
+            "the temporary file is removed"
+        );
+    }
 
     #[test]
     fn writability_is_checked_at_the_nearest_existing_folder_and_names_the_path_given() {

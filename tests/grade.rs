@@ -12,8 +12,14 @@ mod class;
 mod cli;
 #[path = "grade/integrity.rs"]
 mod integrity;
+#[path = "grade/memory.rs"]
+mod memory;
 #[path = "grade/rubrics.rs"]
 mod rubrics;
+#[path = "grade/scale.rs"]
+mod scale;
+#[path = "grade/sched.rs"]
+mod sched;
 
 use std::collections::BTreeMap;
 use std::fs;
@@ -44,6 +50,7 @@ fn graded() -> &'static Graded {
         let options = GradeOptions {
             out: out.clone(),
             cache: None,
+            ..GradeOptions::default()
         };
         let started = Instant::now();
         let report =
@@ -375,6 +382,7 @@ fn a_wide_class_table_keeps_names_and_lost_points_on_screen() {
     let options = GradeOptions {
         out: out.clone(),
         cache: Some(dir.path().join("cache")),
+        ..GradeOptions::default()
     };
     let report = grade_class(&rubric_path, &dir.path().join("submissions"), &options, &Silent).unwrap();
     assert_eq!(student(&report, "bob").images[20].outcome, Outcome::Missing);
@@ -430,6 +438,7 @@ fn passing_pictures_are_thumbnails_and_only_lost_points_get_heatmaps() {
     let options = GradeOptions {
         out: out.clone(),
         cache: Some(dir.path().join("cache")),
+        ..GradeOptions::default()
     };
     let report = grade_class(&dir.path().join("r.toml"), &dir.path().join("subs"), &options, &Silent).unwrap();
     let nearly = &student(&report, "nearly").images[0];

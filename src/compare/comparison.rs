@@ -2,6 +2,7 @@
 
 use std::fmt;
 use std::path::PathBuf;
+use std::time::Duration;
 
 use serde::Serialize;
 
@@ -28,6 +29,12 @@ pub struct Comparison {
 /// A NaN limit counts as 0, the strictest: every comparison with NaN is false, so taken as given
 /// it would let any difference through.
 pub fn compare(expected: &Image, actual: &Image, tolerance: &Tolerance) -> Comparison {
+    compare_timed(expected, actual, tolerance).0
+}
+
+/// [`compare`], and how long its FLIP measurement took (zero when nothing was measured), for
+/// callers that report where their time goes.
+pub fn compare_timed(expected: &Image, actual: &Image, tolerance: &Tolerance) -> (Comparison, Duration) {
     let strict = |limit: f64| if limit.is_nan() { 0.0 } else { limit };
     let tolerance = &Tolerance {
         pixel: strict(tolerance.pixel),
@@ -35,25 +42,26 @@ pub fn compare(expected: &Image, actual: &Image, tolerance: &Tolerance) -> Compa
         rmse: strict(tolerance.rmse),
         max: tolerance.max.map(strict),
     };
-    let (metrics, verdict) = if same_layout(expected, actual) {
-        let metrics = measure(expected, actual, tolerance.pixel);
+    let (metrics, verdict, flip) = if same_layout(expected, actual) {
+        let (metrics, flip) = measure(expected, actual, tolerance.pixel);
         let verdict = judge(&metrics, tolerance);
-        (Some(metrics), verdict)
+        (Some(metrics), verdict, flip)
     } else {
         let verdict = Verdict::Mismatch {
             expected: Layout::of(expected),
             actual: Layout::of(actual),
         };
-        (None, verdict)
+        (None, verdict, Duration::ZERO)
     };
-    Comparison {
+    let comparison = Comparison {
         expected: expected.source.clone(),
         actual: actual.source.clone(),
         tolerance: tolerance.clone(),
         metrics,
         verdict,
         diff_image: None,
-    }
+    };
+    (comparison, flip)
 }
 
 #[derive(Serialize)]

@@ -5,14 +5,14 @@ use std::path::{Path, PathBuf};
 
 use ::exr::meta::MetaData;
 use image::RgbImage;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::error::CompareError;
 use crate::film::{Film, Tonemap, color_image, decode_exr};
 
 /// The EXR channels goldray writes and reads, in the contract's order. Other channels in a file
 /// are not compared, because the film reader does not decode them.
-const FILM_CHANNELS: [&str; 7] = ["R", "G", "B", "Z", "N.X", "N.Y", "N.Z"];
+pub(super) const FILM_CHANNELS: [&str; 7] = ["R", "G", "B", "Z", "N.X", "N.Y", "N.Z"];
 
 /// The colour channels: the ones MAE, RMSE, PSNR and the worst pixel are measured on.
 pub const COLOR_CHANNELS: [&str; 3] = ["R", "G", "B"];
@@ -21,7 +21,7 @@ const EXR_MAGIC: [u8; 4] = [0x76, 0x2f, 0x31, 0x01];
 const PNG_MAGIC: [u8; 8] = [0x89, b'P', b'N', b'G', b'\r', b'\n', 0x1a, b'\n'];
 
 /// How the values of an image are encoded, which sets the units of every threshold and metric.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Encoding {
     /// Scene-referred linear floats (EXR); PSNR is measured against a peak of 1.

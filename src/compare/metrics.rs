@@ -2,7 +2,9 @@
 //! arithmetic, because `NaN > threshold` is false: a NaN that reached a subtraction would make a
 //! broken pixel look perfect.
 
-use serde::Serialize;
+use std::time::{Duration, Instant};
+
+use serde::{Deserialize, Deserializer, Serialize};
 
 use super::image::{COLOR_CHANNELS, Channel, Encoding, Image};
 
@@ -14,6 +16,30 @@ pub struct PixelError {
     pub channel: &'static str,
     pub expected: f32,
     pub actual: f32,
+}
+
+/// [`PixelError`] as read back from JSON: the channel named by a string, and `null` for the
+/// infinite values JSON cannot write.
+#[derive(Deserialize)]
+struct PixelErrorJson {
+    x: u32,
+    y: u32,
+    channel: String,
+    expected: Option<f32>,
+    actual: Option<f32>,
+}
+
+impl<'de> Deserialize<'de> for PixelError {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<PixelError, D::Error> {
+        let json = PixelErrorJson::deserialize(deserializer)?;
+        Ok(PixelError {
+            x: json.x,
+            y: json.y,
+            channel: channel_name(&json.channel).map_err(serde::de::Error::custom)?,
+            expected: json.expected.unwrap_or(f32::INFINITY),
+            actual: json.actual.unwrap_or(f32::INFINITY),
+        })
+    }
 }
 
 impl PixelError {
@@ -71,8 +97,26 @@ pub struct ChannelStats {
     pub worst: Option<PixelError>,
 }
 
+#[derive(Deserialize)]
+struct ChannelStatsJson {
+    name: String,
+    failing: usize,
+    worst: Option<PixelError>,
+}
+
+impl<'de> Deserialize<'de> for ChannelStats {
+    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<ChannelStats, D::Error> {
+        let json = ChannelStatsJson::deserialize(deserializer)?;
+        Ok(ChannelStats {
+            name: channel_name(&json.name).map_err(serde::de::Error::custom)?,
+            failing: json.failing,
+            worst: json.worst,
+        })
+    }
+}
+
 /// Values that are NaN or infinite in one image and not in the other.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct NonFinite {
     /// Channel values, not pixels: one NaN pixel in R and G counts 2.
     pub count: usize,
@@ -82,7 +126,7 @@ pub struct NonFinite {
 /// The measurements of one image pair. MAE, RMSE, PSNR and `worst` are over colour (R, G, B) in
 /// the images' units (linear values for EXR, 8-bit codes for PNG); the failing-pixel count looks
 /// at every channel, AOVs included.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Metrics {
     pub encoding: Encoding,
     pub pixels: usize,
@@ -93,6 +137,7 @@ pub struct Metrics {
     pub mae: f64,
     pub rmse: f64,
     /// In dB against the encoding's peak (1 or 255); infinite for identical colour.
+    #[serde(deserialize_with = "null_is_infinite")]
     pub psnr: f64,
     /// NVIDIA's FLIP, mean over the picture of the sRGB 8-bit colour: 0 identical, 1 opposite.
     pub flip: f64,
@@ -102,8 +147,9 @@ pub struct Metrics {
     pub non_finite: Option<NonFinite>,
 }
 
-/// Both images must have the same size and channel list (`compare` checks that first).
-pub(super) fn measure(expected: &Image, actual: &Image, pixel_threshold: f64) -> Metrics {
+/// Both images must have the same size and channel list (`compare` checks that first). Also
+/// returns how long FLIP took, which is most of a comparison's cost.
+pub(super) fn measure(expected: &Image, actual: &Image, pixel_threshold: f64) -> (Metrics, Duration) {
     let width = expected.width as usize;
     let pixels = expected.pixels();
     let mut failing = vec![false; pixels];
@@ -159,7 +205,10 @@ pub(super) fn measure(expected: &Image, actual: &Image, pixel_threshold: f64) ->
     let mse = sum_sq / color_values;
     let peak = expected.encoding.peak();
     let failing_pixels = failing.iter().filter(|&&f| f).count();
-    Metrics {
+    let flip_started = Instant::now();
+    let flip = super::flip::flip_mean(&expected.preview, &actual.preview);
+    let flip_time = flip_started.elapsed();
+    let metrics = Metrics {
         encoding: expected.encoding,
         pixels,
         pixel_threshold,
@@ -172,11 +221,28 @@ pub(super) fn measure(expected: &Image, actual: &Image, pixel_threshold: f64) ->
         } else {
             10.0 * (peak * peak / mse).log10()
         },
-        flip: super::flip::flip_mean(&expected.preview, &actual.preview),
+        flip,
         worst: worst_color(&channels),
         channels,
         non_finite,
-    }
+    };
+    (metrics, flip_time)
+}
+
+/// A channel name read back from JSON, as the `'static` name the comparator uses: JSON written by
+/// goldray names only channels goldray compares.
+fn channel_name(name: &str) -> Result<&'static str, String> {
+    super::image::FILM_CHANNELS
+        .iter()
+        .find(|known| **known == name)
+        .copied()
+        .ok_or_else(|| format!("unknown channel {name:?}"))
+}
+
+/// JSON has no infinity: serde_json writes an infinite number (the PSNR of identical colour) as
+/// `null`, so `null` reads back as infinity.
+fn null_is_infinite<'de, D: Deserializer<'de>>(deserializer: D) -> Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(deserializer)?.unwrap_or(f64::INFINITY))
 }
 
 fn worst_color(channels: &[ChannelStats]) -> Option<PixelError> {

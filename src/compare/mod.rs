@@ -25,7 +25,7 @@ mod metrics;
 mod tolerance;
 mod verdict;
 
-pub use comparison::{Comparison, compare};
+pub use comparison::{Comparison, compare, compare_timed};
 pub use error::CompareError;
 pub use files::{FileComparison, ToleranceOverrides, compare_files};
 pub use heatmap::{FAILING, NON_FINITE, diff_heatmap};

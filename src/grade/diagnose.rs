@@ -22,6 +22,7 @@
 //! `unexplained`. Speckled mistakes (acne) are compared over blocks, where an independent
 //! program's speckles, drawn elsewhere, have the same density.
 
+mod batch;
 mod candidates;
 mod decide;
 mod expand;
@@ -29,26 +30,21 @@ mod pictures;
 mod residual;
 mod student;
 
-use std::collections::{BTreeMap, HashSet};
+use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
-use std::time::Instant;
 
 use image::RgbImage;
-use rayon::prelude::*;
 
 use super::diagnosis::{Closest, Confidence, Diagnosis, DiagnosisRun, RenderDiagnosis, Residual, UNEXPLAINED};
-use super::error::GradeError;
-use super::golden::Goldens;
 use super::outcome::Outcome;
 use super::rubric::{ImageSpec, Output, Rubric, Rule};
 use super::score::{ImageResult, StudentResult, judge};
-use super::submission::read_png;
-use crate::atomic_write::write_file_atomic;
+use crate::atomic_write::replace_file;
 use crate::compare::{Image, Tolerance, compare, diff_heatmap};
 use crate::fault::{Fault, FaultSet, Gamma, Parameter};
 use crate::film::{Picture, encode_png, picture_with_faults};
-use crate::progress::Progress;
+pub(super) use batch::{Diagnoser, prepare_mistakes};
 use decide::decide;
 use expand::{expansions, fit_background, fit_gamma};
 pub(super) use student::{apply_credit, prefer_consistent};
@@ -187,194 +183,6 @@ impl Subject<'_> {
             speckle,
         }
     }
-}
-
-/// Diagnoses every image of `students` that lost points, writes the mistakes' pictures and the
-/// residual heatmaps into `out`, and fills in each such image's [`Diagnosis`].
-pub(super) fn diagnose_class(
-    rubric: &Rubric,
-    goldens: &Goldens,
-    cache: &Path,
-    students: &mut [StudentResult],
-    out: &Path,
-    progress: &dyn Progress,
-) -> Result<DiagnosisRun, GradeError> {
-    let started = Instant::now();
-    let mut run = DiagnosisRun::default();
-    // Images grouped by golden render (two rubric renders with the same content are one).
-    let mut groups: BTreeMap<&str, Vec<usize>> = BTreeMap::new();
-    for (index, key) in goldens.keys.iter().enumerate() {
-        groups.entry(key.as_str()).or_default().push(index);
-    }
-    let mut groups: Vec<(&str, Vec<usize>)> = groups.into_iter().collect();
-    groups.sort_by_key(|(_, images)| images[0]);
-    let total: usize = students
-        .iter()
-        .map(|s| s.images.iter().filter(|i| loses_points(i)).count())
-        .sum();
-    run.images = total;
-    if total == 0 {
-        return Ok(run);
-    }
-    progress.begin("diagnosing", total as u64);
-    let written = Mutex::new(HashSet::new());
-    for (key, images) in groups {
-        let failing: Vec<(usize, usize)> = students
-            .iter()
-            .enumerate()
-            .flat_map(|(s, student)| {
-                images
-                    .iter()
-                    .filter(|&&i| loses_points(&student.images[i]))
-                    .map(move |&i| (s, i))
-            })
-            .collect();
-        if failing.is_empty() {
-            continue;
-        }
-        let render_started = Instant::now();
-        let source = &rubric.renders[rubric.images[images[0]].render_index];
-        progress.step(&format!("diagnosing images of {}", source.name));
-        // The pictures compared: those of the images that lost points; every picture of the
-        // render is cached, for the gradings to come.
-        let distinct = |images: &mut dyn Iterator<Item = usize>| {
-            let mut pictures: Vec<Picture> = Vec::new();
-            for i in images {
-                let picture = film_picture(rubric.images[i].output);
-                if !pictures.contains(&picture) {
-                    pictures.push(picture);
-                }
-            }
-            pictures
-        };
-        let pictures = distinct(&mut failing.iter().map(|&(_, i)| i));
-        let stored = distinct(&mut images.iter().copied());
-        let film = goldens.films[images[0]].clone();
-        let store = pictures::FaultPictures::new(
-            Some(cache.join("faults").join(key)),
-            &source.case,
-            &film,
-            pictures,
-            stored,
-        );
-        // A fault set that cannot be rendered (it cannot, for the course's scenes) is left out
-        // and said in the run's record, rather than stopping the grading.
-        let failed = Mutex::new(Vec::new());
-        let get = |set: FaultSet| match store.get(&set) {
-            Ok(pictures) => Some(Candidate { set, pictures }),
-            Err(error) => {
-                failed
-                    .lock()
-                    .unwrap_or_else(|p| p.into_inner())
-                    .push(format!("{set}: {error}"));
-                None
-            }
-        };
-        let golden_pictures = store.golden();
-        // Where the golden primary rays hit nothing (the background shows).
-        let misses: Vec<bool> = store.golden_film().depth.iter().map(|t| *t == f32::INFINITY).collect();
-        // Read or rendered side by side: decoding cached pictures is most of a warm run's cost.
-        let singles: Vec<Candidate> = candidates::singles(&source.case, store.pictures())
-            .into_par_iter()
-            .filter_map(get)
-            .collect();
-
-        // The students' pictures and their singles' scores, in parallel.
-        let subjects: Vec<Option<Subject>> = failing
-            .par_iter()
-            .map(|&(s, i)| {
-                let spec = &rubric.images[i];
-                let index = store.pictures().iter().position(|p| *p == film_picture(spec.output))?;
-                let file = students[s].images[i].graded_file.as_ref()?;
-                let student = read_png(file).ok()?.picture;
-                let golden = &golden_pictures[index];
-                if student.dimensions() != golden.dimensions() {
-                    return None;
-                }
-                let block = residual::block_size(golden);
-                Some(Subject {
-                    spec,
-                    picture: index,
-                    by_pixel: residual::residual(golden, &student, spec.rule.threshold),
-                    by_block: residual::block_residual(golden, &student, spec.rule.threshold, block),
-                    student,
-                    golden,
-                    block,
-                })
-            })
-            .collect();
-        let scored: Vec<Vec<Scored>> = subjects
-            .par_iter()
-            .map(|subject| match subject {
-                Some(subject) => singles.iter().filter_map(|c| subject.score(c)).collect(),
-                None => Vec::new(),
-            })
-            .collect();
-
-        // What each image wants tried next, rendered once for all of them.
-        let mut wanted: Vec<FaultSet> = Vec::new();
-        for (subject, scores) in subjects.iter().zip(&scored) {
-            if let Some(subject) = subject {
-                let background = fit_background(subject, &misses, &singles);
-                for set in expansions(&source.case, subject, scores, &singles)
-                    .into_iter()
-                    .chain(background)
-                {
-                    if !wanted.contains(&set) && !singles.iter().any(|c| c.set == set) {
-                        wanted.push(set);
-                    }
-                }
-            }
-        }
-        let expanded: Vec<Candidate> = wanted.into_par_iter().filter_map(get).collect();
-
-        let decided: Vec<Option<(Diagnosis, usize, usize)>> = failing
-            .par_iter()
-            .zip(subjects.par_iter().zip(scored.par_iter()))
-            .map(|(&(s, i), (subject, scores))| {
-                let subject = subject.as_ref()?;
-                let mut scores = scores.clone();
-                let known = |set: &FaultSet| singles.iter().chain(&expanded).find(|c| c.set == *set);
-                // A pair that draws this picture as one of its faults alone does has no evidence
-                // of the other.
-                let adds_nothing = |c: &Candidate| {
-                    c.set.len() > 1
-                        && c.set.faults().any(|f| {
-                            known(&c.set.without(f))
-                                .is_some_and(|m| m.pictures[subject.picture] == c.pictures[subject.picture])
-                        })
-                };
-                scores.extend(
-                    expanded
-                        .iter()
-                        .filter(|c| !adds_nothing(c))
-                        .filter_map(|c| subject.score(c)),
-                );
-                scores.extend(fit_gamma(subject, &store, &scores));
-                let slug = student_dir(&students[s]);
-                let diagnosis = decide(subject, &scores, &store, &expanded, &singles, out, &slug, &written);
-                progress.advance(1);
-                Some((diagnosis, s, i))
-            })
-            .collect();
-        for (diagnosis, s, i) in decided.into_iter().flatten() {
-            run.explained += usize::from(diagnosis.id != UNEXPLAINED);
-            students[s].images[i].diagnosis = Some(diagnosis);
-        }
-        let rendered = store.rendered.load(std::sync::atomic::Ordering::Relaxed);
-        run.renders.push(RenderDiagnosis {
-            render: source.name.clone(),
-            images: failing.len(),
-            fault_sets: singles.len() + expanded.len(),
-            rendered,
-            cached: store.cached.load(std::sync::atomic::Ordering::Relaxed),
-            seconds: render_started.elapsed().as_secs_f64(),
-            failed: failed.into_inner().unwrap_or_else(|p| p.into_inner()),
-        });
-    }
-    progress.finish();
-    run.seconds = started.elapsed().as_secs_f64();
-    Ok(run)
 }
 
 fn film_picture(output: Output) -> Picture {

@@ -2,7 +2,7 @@
 //! How they are found is `diagnose`'s job; keeping the records apart lets the score and the
 //! report carry them without depending on the diagnosis itself.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::compare::Metrics;
 use crate::fault::FaultSet;
@@ -12,7 +12,7 @@ pub const UNEXPLAINED: &str = "unexplained";
 
 /// What explains an image that lost points. `grades.json` holds it per image, only for images
 /// that did not get full points.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Diagnosis {
     /// A catalogue id, two joined by `+`, or `unexplained`.
     pub id: String,
@@ -50,7 +50,7 @@ pub struct Diagnosis {
     pub ties: Vec<FaultSet>,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Confidence {
     /// The image passes against the mistake's picture and no other mistake comes close.
@@ -61,7 +61,7 @@ pub enum Confidence {
     None,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Closest {
     pub id: String,
     pub faults: String,
@@ -69,7 +69,7 @@ pub struct Closest {
 }
 
 /// What diagnosing a class cost, render by render, for `grades.json` and the summary.
-#[derive(Clone, Debug, Default, Serialize)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct DiagnosisRun {
     pub seconds: f64,
     /// Images that lost points, and how many of them a mistake explains.
@@ -78,7 +78,7 @@ pub struct DiagnosisRun {
     pub renders: Vec<RenderDiagnosis>,
 }
 
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct RenderDiagnosis {
     pub render: String,
     pub images: usize,
@@ -88,12 +88,12 @@ pub struct RenderDiagnosis {
     pub cached: usize,
     pub seconds: f64,
     /// Fault sets that could not be rendered, with the reason; left out of the comparison.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub failed: Vec<String>,
 }
 
 /// The failing fraction and RMSE of one picture against another.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Residual {
     /// Pixels (or blocks) with a channel more than the rubric's threshold away.
     pub failing_fraction: f64,

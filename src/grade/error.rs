@@ -33,6 +33,11 @@ pub enum GradeError {
     #[error("cannot write the report: {0}")]
     Write(#[from] OutputError),
 
+    /// Shard outputs that do not make one class: missing, overlapping, or made with another
+    /// rubric, golden renders or goldray.
+    #[error("cannot merge: {0}")]
+    Merge(String),
+
     #[error("cannot start worker threads: {0}")]
     Threads(#[from] rayon::ThreadPoolBuildError),
 }

@@ -18,7 +18,7 @@ use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
 use image::RgbImage;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::error::GradeError;
 use super::rubric::{Output, Rubric};
@@ -34,7 +34,7 @@ use crate::provenance::Provenance;
 pub const GOLDEN_DIR: &str = "golden";
 
 /// How one render of the rubric was obtained, for the JSON report.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct GoldenRender {
     pub render: String,
     /// The cache key: the EXR is `CACHE/KEY.exr`.
@@ -45,6 +45,15 @@ pub struct GoldenRender {
     pub seconds: f64,
     /// Why the render could not be cached, if it could not; grading goes on without the cache.
     pub cache_note: Option<String>,
+}
+
+/// Whether a run may add to the golden cache. Shards of a class read a cache prepared once
+/// (`goldray grade --prepare`), which may sit on a read-only shared folder: what they do not
+/// find there they render for themselves and keep in memory only.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CacheMode {
+    ReadWrite,
+    ReadOnly,
 }
 
 /// The golden pictures in rubric order, as 8-bit images ready to compare.
@@ -72,12 +81,12 @@ pub fn default_cache_dir() -> PathBuf {
         .join("goldens")
 }
 
-/// Renders (or loads from `cache_dir`) every render an image uses, and writes each golden picture
-/// to `REPORT/golden/FILE` for the HTML report.
+/// Renders (or loads from `cache_dir`) every render an image uses, storing what it rendered in the
+/// cache unless `mode` is read-only.
 pub fn prepare_goldens(
     rubric: &Rubric,
     cache_dir: &Path,
-    report_dir: &Path,
+    mode: CacheMode,
     progress: &dyn Progress,
 ) -> Result<Goldens, GradeError> {
     let mut films: HashMap<usize, Arc<Film>> = HashMap::new();
@@ -113,7 +122,10 @@ pub fn prepare_goldens(
                     render: source.name.clone(),
                     source: Box::new(source_error),
                 })?;
-                let note = store(&path, &film, provenance_of(rubric, index, &mut provenances)?).err();
+                let note = match mode {
+                    CacheMode::ReadWrite => store(&path, &film, provenance_of(rubric, index, &mut provenances)?).err(),
+                    CacheMode::ReadOnly => Some("not stored: this run only reads the cache".to_owned()),
+                };
                 (film, false, note)
             }
         };
@@ -142,13 +154,7 @@ pub fn prepare_goldens(
             Output::Normals => normals_image(film, tonemap),
             Output::Depth { min, max } => depth_image(film, min as f32, max as f32, tonemap),
         };
-        let path = report_dir.join(GOLDEN_DIR).join(&spec.file);
-        write_golden_png(
-            &path,
-            &picture,
-            provenance_of(rubric, spec.render_index, &mut provenances)?,
-        )?;
-        images.push(Image::from_rgb8(picture, path));
+        images.push(Image::from_rgb8(picture, Path::new(GOLDEN_DIR).join(&spec.file)));
     }
     Ok(Goldens {
         renders,
@@ -156,6 +162,21 @@ pub fn prepare_goldens(
         keys: image_keys,
         films: image_films,
     })
+}
+
+/// Writes each golden picture to `REPORT/golden/FILE`, for the HTML report.
+/// Each carries the provenance of its render.
+pub fn write_golden_pictures(rubric: &Rubric, goldens: &Goldens, report_dir: &Path) -> Result<(), GradeError> {
+    let mut provenances = HashMap::new();
+    for (spec, image) in rubric.images.iter().zip(&goldens.images) {
+        let provenance = provenance_of(rubric, spec.render_index, &mut provenances)?;
+        write_golden_png(
+            &report_dir.join(GOLDEN_DIR).join(&spec.file),
+            &image.preview,
+            provenance,
+        )?;
+    }
+    Ok(())
 }
 
 /// The cached film, if there is a readable one of the right size. A damaged entry is treated as

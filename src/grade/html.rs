@@ -15,7 +15,7 @@ use super::golden::GOLDEN_DIR;
 use super::outcome::Outcome;
 use super::report::{ClassReport, flags, format_points};
 use super::score::{ImageResult, StudentResult, percent};
-use crate::atomic_write::write_file_atomic;
+use crate::atomic_write::{replace_file, write_file_atomic};
 use crate::compare::Metrics;
 use crate::film::OutputError;
 
@@ -77,7 +77,7 @@ addEventListener('load', function () {
 pub fn write_html(report: &ClassReport, out: &Path) -> Result<(), OutputError> {
     write_file_atomic(&out.join("index.html"), index(report).as_bytes())?;
     for student in &report.students {
-        write_file_atomic(&out.join(&student.page), student_page(report, student).as_bytes())?;
+        replace_file(&out.join(&student.page), student_page(report, student).as_bytes())?;
     }
     Ok(())
 }

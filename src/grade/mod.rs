@@ -11,7 +11,7 @@
 //! use goldray::grade::{GradeOptions, grade_class};
 //! # fn main() -> Result<(), goldray::grade::GradeError> {
 //! use goldray::progress::Silent;
-//! let options = GradeOptions { out: "report".into(), cache: None };
+//! let options = GradeOptions { out: "report".into(), ..GradeOptions::default() };
 //! let report = grade_class("rubrics/mit6837.toml".as_ref(), "submissions".as_ref(), &options, &Silent)?;
 //! for student in &report.students {
 //!     println!("{}: {} / {}", student.name, student.total, student.max_points);
@@ -20,6 +20,7 @@
 //! # }
 //! ```
 
+mod class;
 mod diagnose;
 mod diagnosis;
 mod error;
@@ -28,37 +29,56 @@ mod html;
 mod integrity;
 mod outcome;
 mod report;
+mod resume;
 mod rubric;
 mod score;
+mod shard;
 mod similarity;
 mod submission;
+mod timing;
 
 use std::collections::BTreeMap;
-use std::fs;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicUsize, Ordering};
-
-use rayon::prelude::*;
 
 use crate::progress::Progress;
 pub use diagnose::{FAILING_REDUCTION, MISTAKES_DIR, RMSE_REDUCTION, explains, loses_points};
 pub use diagnosis::{Closest, Confidence, Diagnosis, DiagnosisRun, RenderDiagnosis, Residual, UNEXPLAINED};
 pub use error::{GradeError, RubricError};
-pub use golden::{GoldenRender, Goldens, default_cache_dir, prepare_goldens};
+pub use golden::{CacheMode, GoldenRender, Goldens, default_cache_dir, prepare_goldens, write_golden_pictures};
 pub use integrity::{Integrity, LinkPolicy, PUBLISHED_COPY};
 pub use outcome::Outcome;
 pub use report::{ClassReport, RubricSummary, diagnoses_of, flags, mistakes_of};
+pub use resume::{RESULT_FILE, StudentRecord};
 pub use rubric::{ImageSpec, Output, RenderSource, Rubric, Rule, load_rubric, parse_rubric};
 pub use score::{ImageResult, StudentResult, Submission, grade_image, judge};
-use similarity::similar_pairs;
+pub use shard::{MANIFEST, Manifest, Shard, ShardError};
 pub use similarity::{NEAR_IDENTICAL, SimilarPair};
+pub use timing::{RunCost, Timings};
 
-/// Where the report and the golden cache go.
+/// Where the report and the golden cache go, which slice of the class to grade, and whether
+/// results kept from an earlier run may be reused.
 #[derive(Clone, Debug)]
 pub struct GradeOptions {
     pub out: PathBuf,
     /// `None`: [`default_cache_dir`].
     pub cache: Option<PathBuf>,
+    /// [`Shard::WHOLE`], or one slice of the class: its report folder is then only for
+    /// [`merge_shards`], and the cache is only read.
+    pub shard: Shard,
+    /// Grade every student again, even those whose result an earlier run left and whose files
+    /// have not changed.
+    pub force: bool,
+}
+
+impl Default for GradeOptions {
+    fn default() -> GradeOptions {
+        GradeOptions {
+            out: PathBuf::from("grade-report"),
+            cache: None,
+            shard: Shard::WHOLE,
+            force: false,
+        }
+    }
 }
 
 /// Whether grading names the mistake behind each image that lost points (see [`Diagnosis`]).
@@ -70,9 +90,8 @@ pub enum Diagnose {
 
 /// Loads the rubric, prepares the goldens, grades every student folder of `submissions` on the
 /// current rayon pool, diagnoses the images that lost points and writes the whole report.
-/// Golden renders, then graded students, then diagnosed images are reported to `progress`.
-/// Returns an error only when grading could not run; what students handed in never makes it
-/// fail.
+/// Golden renders, then graded students, are reported to `progress`. Returns an error only when
+/// grading could not run; what students handed in never makes it fail.
 pub fn grade_class(
     rubric_path: &Path,
     submissions: &Path,
@@ -82,7 +101,10 @@ pub fn grade_class(
     grade_class_diagnosing(rubric_path, submissions, options, Diagnose::Yes, progress)
 }
 
-/// [`grade_class`], diagnosing or not.
+/// [`grade_class`], diagnosing or not. Students are streamed (see [`class`]); each one's result
+/// is kept in the report folder, and reused by the next run with the same inputs unless
+/// `options.force`. With a shard, only that slice is graded and the class-wide files are left to
+/// [`merge_shards`].
 pub fn grade_class_diagnosing(
     rubric_path: &Path,
     submissions: &Path,
@@ -90,123 +112,40 @@ pub fn grade_class_diagnosing(
     diagnose: Diagnose,
     progress: &dyn Progress,
 ) -> Result<ClassReport, GradeError> {
-    let rubric = load_rubric(rubric_path)?;
-    let out = &options.out;
-    let cache = options.cache.clone().unwrap_or_else(default_cache_dir);
-    let (folders, ignored) = student_folders(submissions, &[out, &cache])?;
-    let goldens = prepare_goldens(&rubric, &cache, out, progress)?;
-
-    let names: Vec<String> = folders.keys().cloned().collect();
-    let folders: Vec<Submission> = folders
-        .into_iter()
-        .zip(report::slugs(&names))
-        .collect::<Vec<_>>()
-        .into_par_iter()
-        .map(|((name, path), slug)| Submission::new(name, path, slug))
-        .collect();
-    // One task per image rather than per student, so that both cores stay busy to the end of a
-    // small class.
-    let per_student = rubric.images.len();
-    let published = integrity::published_hashes(&rubric.integrity, rubric.images.iter().map(|spec| spec.file.as_str()));
-    progress.begin("grading", (folders.len() * per_student) as u64);
-    // Images left per student, so that the last one to finish can say the student is done.
-    let left: Vec<AtomicUsize> = folders.iter().map(|_| AtomicUsize::new(per_student)).collect();
-    let results = (0..folders.len() * per_student)
-        .into_par_iter()
-        .map(|task| {
-            let (student, image) = (task / per_student, task % per_student);
-            let spec = &rubric.images[image];
-            let result = grade_image(
-                spec,
-                &goldens.images[image],
-                &folders[student],
-                &rubric.integrity,
-                published.get(&spec.file).copied(),
-                out,
-            );
-            progress.advance(1);
-            if left[student].fetch_sub(1, Ordering::Relaxed) == 1 {
-                progress.done(&folders[student].name);
-            }
-            result
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    progress.finish();
-    let mut results = results.into_iter();
-    let mut students: Vec<StudentResult> = folders
-        .iter()
-        .map(|submission| StudentResult::new(submission, results.by_ref().take(per_student).collect()))
-        .collect();
-    let diagnosis = if diagnose == Diagnose::Yes {
-        let run = diagnose::diagnose_class(&rubric, &goldens, &cache, &mut students, out, progress)?;
-        diagnose::prefer_consistent(&mut students);
-        diagnose::apply_credit(&rubric, &mut students);
-        Some(run)
-    } else {
-        None
-    };
-    let similar = similar_pairs(
-        &students
-            .iter()
-            .flat_map(|student| {
-                student.images.iter().enumerate().filter_map(|(order, image)| {
-                    Some(similarity::Entry {
-                        student: &student.name,
-                        file: &image.file,
-                        order,
-                        path: image.graded_file.as_deref()?,
-                        fingerprint: image.fingerprint.as_ref()?,
-                    })
-                })
-            })
-            .collect::<Vec<_>>(),
-    );
-
-    let report = ClassReport {
-        goldray: env!("CARGO_PKG_VERSION"),
-        rubric: RubricSummary::of(&rubric),
-        submissions: submissions.to_path_buf(),
-        cache: cache.clone(),
-        goldens: goldens.renders,
-        diagnosis,
-        ignored,
-        students,
-        similar,
-    };
-    report::write_data(&report, out)?;
-    html::write_html(&report, out)?;
-    Ok(report)
+    class::grade(rubric_path, submissions, options, diagnose, progress)
 }
 
-/// Student folders by name, and the names of the other entries. Hidden entries and `__MACOSX` are
-/// skipped silently, and so are the report and cache directories when they sit inside
-/// `submissions` (so that grading twice does not grade the first report).
-fn student_folders(
-    submissions: &Path,
-    own: &[&PathBuf],
-) -> Result<(BTreeMap<String, PathBuf>, Vec<String>), GradeError> {
-    let error = |source| GradeError::Submissions {
-        path: submissions.to_path_buf(),
-        source,
+/// Combines the report folders of the N shards of a class into `out`, as one run over the whole
+/// class would have written it; refuses shards of different rubrics, golden renders or classes,
+/// and overlapping or missing slices.
+pub fn merge_shards(out: &Path, shards: &[PathBuf]) -> Result<ClassReport, GradeError> {
+    class::merge(out, shards)
+}
+
+/// What `--prepare` made: the golden renders, and how many mistakes' pictures were rendered.
+pub struct Prepared {
+    pub goldens: Vec<GoldenRender>,
+    pub mistakes_rendered: usize,
+}
+
+/// Fills the golden cache for `rubric_path` (and, when diagnosing, the single mistakes' pictures)
+/// once, so that the shards of a class, which only read the cache, find everything there.
+pub fn prepare_cache(
+    rubric_path: &Path,
+    cache: &Path,
+    diagnose: Diagnose,
+    progress: &dyn Progress,
+) -> Result<Prepared, GradeError> {
+    let rubric = load_rubric(rubric_path)?;
+    let goldens = prepare_goldens(&rubric, cache, CacheMode::ReadWrite, progress)?;
+    let mistakes_rendered = match diagnose {
+        Diagnose::Yes => diagnose::prepare_mistakes(&rubric, &goldens, cache),
+        Diagnose::No => 0,
     };
-    let own: Vec<PathBuf> = own.iter().filter_map(|p| p.canonicalize().ok()).collect();
-    let mut folders = BTreeMap::new();
-    let mut ignored = Vec::new();
-    for entry in fs::read_dir(submissions).map_err(error)? {
-        let entry = entry.map_err(error)?;
-        let name = entry.file_name().to_string_lossy().into_owned();
-        let path = entry.path();
-        if name.starts_with('.') || name == "__MACOSX" || path.canonicalize().is_ok_and(|p| own.contains(&p)) {
-            continue;
-        }
-        if path.is_dir() {
-            folders.insert(name, path);
-        } else {
-            ignored.push(name);
-        }
-    }
-    ignored.sort();
-    Ok((folders, ignored))
+    Ok(Prepared {
+        goldens: goldens.renders,
+        mistakes_rendered,
+    })
 }
 
 /// What the TA reads on the terminal: how many of each verdict, and where the report is.
@@ -220,13 +159,22 @@ pub fn summary(report: &ClassReport, out: &Path) -> String {
     let diagnosis = report.diagnosis.as_ref().map_or(String::new(), |run| {
         let renders: usize = run.renders.iter().map(|r| r.rendered).sum();
         let cached: usize = run.renders.iter().map(|r| r.cached).sum();
+        // Counted over the class: students kept from an earlier run keep their diagnoses.
+        let diagnosed: Vec<&Diagnosis> = report
+            .students
+            .iter()
+            .flat_map(|s| &s.images)
+            .filter_map(|i| i.diagnosis.as_ref())
+            .collect();
+        let explained = diagnosed.iter().filter(|d| d.id != UNEXPLAINED).count();
         format!(
-            "\ndiagnosed {} images that lost points: {} explained by a known mistake ({renders} mistake renders, {cached} cached, {:.1} s)",
-            run.images, run.explained, run.seconds
+            "\ndiagnosed {} images that lost points: {explained} explained by a known mistake ({renders} mistake renders, {cached} cached, {:.1} s)",
+            diagnosed.len(),
+            run.seconds
         )
     });
     format!(
-        "graded {} students on {} images ({}); {} golden renders ({rendered} rendered, {} cached in {}){diagnosis}\nreport: {}",
+        "graded {} students on {} images ({}); {} golden renders ({rendered} rendered, {} cached in {}){diagnosis}\n{}\nreport: {}",
         report.students.len(),
         report.rubric.images.len(),
         if counts.is_empty() {
@@ -237,6 +185,39 @@ pub fn summary(report: &ClassReport, out: &Path) -> String {
         report.goldens.len(),
         report.goldens.len() - rendered,
         report.cache.display(),
+        time_spent(&report.cost),
         out.join("index.html").display()
     )
+}
+
+/// Where the time went: the run's wall-clock time, the students graded and kept, and per graded
+/// student the seconds of each step.
+pub fn time_spent(cost: &RunCost) -> String {
+    let kept = if cost.reused > 0 {
+        format!(", {} kept from an earlier run", cost.reused)
+    } else {
+        String::new()
+    };
+    let shards = if cost.shards > 1 {
+        format!(" over {} shards", cost.shards)
+    } else {
+        String::new()
+    };
+    let mut text = format!(
+        "time: {:.1} s{shards} ({} students graded{kept})",
+        cost.seconds, cost.graded
+    );
+    if cost.graded > 0 {
+        let each = cost.timings.per(cost.graded);
+        text.push_str(&format!(
+            "; per graded student {:.3} s: decode {:.3} s, compare {:.3} s, FLIP {:.3} s, diagnosis {:.3} s, report {:.3} s",
+            each.total(),
+            each.decode,
+            each.compare,
+            each.flip,
+            each.diagnosis,
+            each.report
+        ));
+    }
+    text
 }

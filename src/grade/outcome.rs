@@ -1,10 +1,10 @@
 //! The verdict on one submitted file: what grading and reading a submission both produce.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// The verdict on one expected file. Only the first three come from a comparison; the others say
 /// why there was nothing to compare, and score nothing.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "verdict", rename_all = "snake_case")]
 pub enum Outcome {
     /// Within the rule's pass limits: full points.

@@ -4,13 +4,14 @@
 use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize, Serializer};
 
 use super::diagnosis::DiagnosisRun;
 use super::golden::GoldenRender;
 use super::rubric::{ImageSpec, Rubric};
 use super::score::StudentResult;
 use super::similarity::SimilarPair;
+use super::timing::RunCost;
 use crate::atomic_write::write_file_atomic;
 use crate::film::OutputError;
 
@@ -23,8 +24,12 @@ pub struct ClassReport {
     pub submissions: PathBuf,
     /// Where the golden renders were cached.
     pub cache: PathBuf,
+    /// Each render's name and cache key (what it cost goes to `run.json`).
+    #[serde(serialize_with = "renders_and_keys")]
     pub goldens: Vec<GoldenRender>,
     /// What diagnosing the images that lost points cost; `None` when grading did not diagnose.
+    /// In `run.json`, not `grades.json`, which holds only what the same inputs always give.
+    #[serde(skip)]
     pub diagnosis: Option<DiagnosisRun>,
     /// Entries of the submissions folder that are not student folders (loose files), by name.
     pub ignored: Vec<String>,
@@ -32,16 +37,55 @@ pub struct ClassReport {
     pub students: Vec<StudentResult>,
     /// Pairs of students who handed in the same picture, or nearly the same failing one.
     pub similar: Vec<SimilarPair>,
+    /// What this run cost and where the time went (`run.json`).
+    #[serde(skip)]
+    pub cost: RunCost,
 }
 
-#[derive(Clone, Debug, Serialize)]
+/// `grades.json`'s `goldens`: which render, under which cache key; whether it was cached and how
+/// long it took belong to one run, not to the grades.
+fn renders_and_keys<S: Serializer>(goldens: &[GoldenRender], serializer: S) -> Result<S::Ok, S::Error> {
+    #[derive(Serialize)]
+    struct Render<'a> {
+        render: &'a str,
+        key: &'a str,
+    }
+    serializer.collect_seq(goldens.iter().map(|g| Render {
+        render: &g.render,
+        key: &g.key,
+    }))
+}
+
+/// `run.json`: what one grading run (or the shards a merge combined) cost. Unlike `grades.json`,
+/// it differs from run to run.
+#[derive(Serialize)]
+struct RunFile<'a> {
+    #[serde(flatten)]
+    cost: &'a RunCost,
+    goldens: &'a [GoldenRender],
+    diagnosis: &'a Option<DiagnosisRun>,
+}
+
+/// Writes `run.json` into `out`.
+pub fn write_run(report: &ClassReport, out: &Path) -> Result<(), OutputError> {
+    let file = RunFile {
+        cost: &report.cost,
+        goldens: &report.goldens,
+        diagnosis: &report.diagnosis,
+    };
+    let json = serde_json::to_string_pretty(&file).unwrap_or_default();
+    write_file_atomic(&out.join("run.json"), (json + "\n").as_bytes())?;
+    Ok(())
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct RubricSummary {
     pub path: PathBuf,
     pub title: String,
     pub max_points: f64,
     pub images: Vec<ImageSpec>,
     /// The rubric's credit per diagnosed mistake, by catalogue id (absent: none).
-    #[serde(skip_serializing_if = "BTreeMap::is_empty")]
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub mistake_credit: BTreeMap<String, f64>,
 }
 

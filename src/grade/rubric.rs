@@ -6,7 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::error::RubricError;
 use super::integrity::{Integrity, integrity};
@@ -44,7 +44,7 @@ pub struct RenderSource {
 }
 
 /// Which picture of a render an image is, as the course binary writes it.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "lowercase")]
 pub enum Output {
     Color,
@@ -66,7 +66,7 @@ named_enum! {
 }
 
 /// One `[image."FILE"]`: an expected file of every submission.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ImageSpec {
     pub file: String,
     pub render: String,
@@ -81,7 +81,7 @@ pub struct ImageSpec {
 /// How a comparison becomes points: full points when both the failing-pixel fraction and the
 /// FLIP mean are within the pass limits, `partial_credit × points` when within the partial limits,
 /// nothing otherwise. A pixel fails when any channel differs by more than `threshold` 8-bit codes.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Rule {
     pub threshold: f64,
     pub pass_fraction: f64,

@@ -2,8 +2,9 @@
 //! explains them, and the measurements behind them.
 
 use std::path::{Path, PathBuf};
+use std::time::Instant;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::diagnosis::Diagnosis;
 use super::golden::GOLDEN_DIR;
@@ -12,12 +13,13 @@ use super::outcome::Outcome;
 use super::rubric::{ImageSpec, Rule};
 use super::similarity::Fingerprint;
 use super::submission::{Folder, read_png};
-use crate::atomic_write::write_file_atomic;
-use crate::compare::{Image, Metrics, Tolerance, compare, diff_heatmap};
-use crate::film::{OutputError, encode_png, write_png};
+use super::timing::{Timings, seconds, timed};
+use crate::atomic_write::replace_file;
+use crate::compare::{Image, Metrics, Tolerance, compare_timed, diff_heatmap};
+use crate::film::{OutputError, encode_png};
 
 /// One expected file of one student.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ImageResult {
     pub file: String,
     #[serde(flatten)]
@@ -41,7 +43,7 @@ pub struct ImageResult {
     pub diagnosis: Option<Diagnosis>,
     /// Evidence for the TA about where the picture came from ("identical to the published
     /// reference"); it changes the points only where the rubric says so.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub flags: Vec<String>,
     /// What finding copies between students needs; not part of the report.
     #[serde(skip)]
@@ -49,7 +51,7 @@ pub struct ImageResult {
 }
 
 /// All of one student's results, in rubric order.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct StudentResult {
     /// The folder's name (lossily decoded if it is not UTF-8).
     pub name: String,
@@ -81,8 +83,13 @@ impl Submission {
         }
     }
 
+    /// Feeds `hasher` what grading the expected files `names` reads of this submission.
+    pub fn hash_inputs<'a>(&self, names: impl Iterator<Item = &'a str>, hasher: &mut impl std::hash::Hasher) {
+        self.files.hash_inputs(names, hasher);
+    }
+
     /// Where the student's pictures go, relative to the report directory.
-    fn dir(&self) -> String {
+    pub fn dir(&self) -> String {
         format!("students/{}", self.slug)
     }
 }
@@ -106,11 +113,11 @@ impl StudentResult {
     }
 }
 
-/// Grades one expected image of one submission against its golden picture, writing the student's
-/// picture and the diff heatmap under `out` when they differ from the golden. Whatever the file,
-/// the result is a verdict; only a failure to write the report is an error.
-/// Grades one expected file of one student. `published` is the pixel hash of the published
-/// reference image of this file, when the rubric names a published folder that has it.
+/// Grades one expected file of one student against its golden picture, writing the student's
+/// picture and the diff heatmap under `out` when they differ from the golden. `published` is the
+/// pixel hash of the published reference image of this file, when the rubric names a published
+/// folder that has it. Whatever the file, the result is a verdict; only a failure to write the
+/// report is an error. `timings` gets the time each step took.
 pub fn grade_image(
     spec: &ImageSpec,
     golden: &Image,
@@ -118,6 +125,7 @@ pub fn grade_image(
     integrity: &Integrity,
     published: Option<u64>,
     out: &Path,
+    timings: &mut Timings,
 ) -> Result<ImageResult, OutputError> {
     let (folder, dir) = (&submission.files, submission.dir());
     let mut result = ImageResult {
@@ -145,37 +153,46 @@ pub fn grade_image(
     if let Some(reason) = refuse_link(&located.path, &submission.path, integrity.links) {
         return Ok(refused(result, Outcome::Linked { reason }));
     }
-    let submitted = match read_png(&located.path) {
+    let submitted = match timed(&mut timings.decode, || read_png(&located.path)) {
         Ok(submitted) => submitted,
         Err(outcome) => return Ok(refused(result, outcome)),
     };
     result.notes.extend(submitted.notes);
 
-    let copy_of_published = published.is_some_and(|hash| hash == pixel_hash(&submitted.picture));
+    let copy_of_published =
+        published.is_some_and(|hash| hash == timed(&mut timings.decode, || pixel_hash(&submitted.picture)));
     if copy_of_published {
         result.flags.push(PUBLISHED_COPY.to_owned());
     }
     let picture = submitted.picture;
     let copy = format!("{dir}/{}", spec.file);
-    let actual = Image::from_rgb8(picture.clone(), located.path);
     let tolerance = Tolerance {
         pixel: spec.rule.threshold,
         fail_fraction: spec.rule.pass_fraction,
         rmse: f64::INFINITY,
         max: None,
     };
-    let Some(metrics) = compare(golden, &actual, &tolerance).metrics else {
+    let compare_started = Instant::now();
+    let actual = Image::from_rgb8(picture.clone(), located.path);
+    let (comparison, flip) = compare_timed(golden, &actual, &tolerance);
+    timings.compare += seconds(compare_started.elapsed().saturating_sub(flip));
+    timings.flip += seconds(flip);
+    let Some(metrics) = comparison.metrics else {
         // Both pictures are 8-bit RGB, so only their sizes can keep them from being compared.
-        write_file_atomic(&out.join(&copy), &encode_png(&actual.preview)?)?;
+        timed(&mut timings.report, || -> Result<(), OutputError> {
+            Ok(replace_file(&out.join(&copy), &encode_png(&actual.preview)?)?)
+        })?;
         result.student_image = Some(copy);
         let outcome = Outcome::WrongSize {
             expected: [golden.width, golden.height],
             actual: [actual.width, actual.height],
         };
-        result.fingerprint = (!copy_of_published).then(|| Fingerprint::of(&picture, true));
+        result.fingerprint =
+            (!copy_of_published).then(|| timed(&mut timings.decode, || Fingerprint::of(&picture, true)));
         return Ok(refused(result, outcome));
     };
     let (outcome, mut explanation) = judge(&spec.rule, &metrics);
+    let report_started = Instant::now();
     if metrics.worst.is_none() {
         // Identical: the golden picture stands in for the student's, and there is no difference
         // to draw, which keeps the report of a good class small.
@@ -183,18 +200,19 @@ pub fn grade_image(
     } else if outcome == Outcome::Pass {
         // Full points: a thumbnail shows what was handed in; there is nothing for the student to
         // find in a full-size copy or a heatmap, and a class that passes keeps a small report.
-        write_file_atomic(&out.join(&copy), &encode_png(&thumbnail(&actual.preview))?)?;
+        replace_file(&out.join(&copy), &encode_png(&thumbnail(&actual.preview))?)?;
         result.student_image = Some(copy);
     } else {
-        write_file_atomic(&out.join(&copy), &encode_png(&actual.preview)?)?;
+        replace_file(&out.join(&copy), &encode_png(&actual.preview)?)?;
         result.student_image = Some(copy);
         if let Some(heatmap) = diff_heatmap(golden, &actual, spec.rule.threshold) {
             let stem = spec.file.strip_suffix(".png").unwrap_or(&spec.file);
             let diff = format!("{dir}/{stem}.diff.png");
-            write_png(&out.join(&diff), &heatmap)?;
+            replace_file(&out.join(&diff), &encode_png(&heatmap)?)?;
             result.diff_image = Some(diff);
         }
     }
+    timings.report += seconds(report_started.elapsed());
     result.points = match outcome {
         Outcome::Pass => spec.points,
         Outcome::Partial => spec.points * spec.rule.partial_credit,
@@ -209,7 +227,9 @@ pub fn grade_image(
     }
     // Matching the golden or the published answer is not copying a classmate.
     if metrics.worst.is_some() && !copy_of_published {
-        result.fingerprint = Some(Fingerprint::of(&picture, outcome != Outcome::Pass));
+        result.fingerprint = Some(timed(&mut timings.decode, || {
+            Fingerprint::of(&picture, outcome != Outcome::Pass)
+        }));
     }
     result.outcome = outcome;
     result.explanation = explanation;

@@ -14,7 +14,7 @@ use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::path::Path;
 
 use image::RgbImage;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::integrity::pixel_hash;
 use super::submission::read_png;
@@ -27,7 +27,7 @@ const SAMPLE: u64 = 512;
 pub const NEAR_IDENTICAL: f64 = 0.9999;
 
 /// What pairing needs to know of one submitted picture.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Fingerprint {
     pub pixels: u64,
     /// Sample hashes, for pictures that lost points (the near-identical test is for those only).

@@ -11,6 +11,7 @@
 //! PNG library chose to store them.
 
 use std::fs::{self, File};
+use std::hash::{Hash, Hasher};
 use std::io::{Cursor, Read};
 use std::path::{Path, PathBuf};
 
@@ -110,6 +111,29 @@ impl Folder {
             path: self.root.join(found),
             note: Some(format!("expected {name}, graded {} instead", found.display())),
         })
+    }
+}
+
+impl Folder {
+    /// Feeds `hasher` everything grading `names` reads from this folder: the listing (which
+    /// decides where each file is found), and for each expected file its path, where a link
+    /// points and its bytes. Files that cannot be read are hashed as such.
+    pub fn hash_inputs<'a>(&self, names: impl Iterator<Item = &'a str>, hasher: &mut impl Hasher) {
+        self.error.hash(hasher);
+        self.files.hash(hasher);
+        for name in names {
+            let Some(located) = self.find(name) else {
+                continue;
+            };
+            located.path.hash(hasher);
+            fs::read_link(&located.path).ok().hash(hasher);
+            fs::canonicalize(&located.path).ok().hash(hasher);
+            let bytes = fs::metadata(&located.path)
+                .ok()
+                .filter(|m| m.is_file() && m.len() <= MAX_FILE_BYTES)
+                .and_then(|_| fs::read(&located.path).ok());
+            bytes.hash(hasher);
+        }
     }
 }
 

@@ -17,6 +17,7 @@ fn goldens_are_rendered_once_then_read_from_the_cache() {
         let options = GradeOptions {
             out: class.dir.join(out),
             cache: Some(cache.clone()),
+            ..GradeOptions::default()
         };
         grade_class(&class.rubric, &class.submissions, &options, &Silent).unwrap_or_else(|e| panic!("{e}"))
     };

@@ -8,7 +8,7 @@ pub(super) fn decide(
     subject: &Subject,
     scores: &[Scored],
     store: &pictures::FaultPictures,
-    expanded: &[Candidate],
+    expanded: &[&Candidate],
     singles: &[Candidate],
     out: &Path,
     student_dir: &str,
@@ -37,7 +37,7 @@ pub(super) fn decide(
     order.extend(rest);
     let picture_of = |set: &FaultSet| -> Option<RgbImage> {
         let index = subject.picture;
-        if let Some(candidate) = singles.iter().chain(expanded).find(|c| c.set == *set) {
+        if let Some(candidate) = singles.iter().chain(expanded.iter().copied()).find(|c| c.set == *set) {
             return Some(candidate.pictures[index].clone());
         }
         if let Some(known) = store.get_if_known(set) {
@@ -185,11 +185,11 @@ fn write_pictures(
         .lock()
         .unwrap_or_else(|p| p.into_inner())
         .insert(absolute.clone());
-    let mistake_ok = !first || encode_png(mistake).is_ok_and(|bytes| write_file_atomic(&absolute, &bytes).is_ok());
+    let mistake_ok = !first || encode_png(mistake).is_ok_and(|bytes| replace_file(&absolute, &bytes).is_ok());
     let stem = file.strip_suffix(".png").unwrap_or(file);
     let residual_path = format!("{student_dir}/{stem}.mistake.png");
     let residual_ok = diff_heatmap(expected, student, subject.spec.rule.threshold).is_some_and(|heatmap| {
-        encode_png(&heatmap).is_ok_and(|bytes| write_file_atomic(&out.join(&residual_path), &bytes).is_ok())
+        encode_png(&heatmap).is_ok_and(|bytes| replace_file(&out.join(&residual_path), &bytes).is_ok())
     });
     (mistake_ok.then_some(mistake_path), residual_ok.then_some(residual_path))
 }

@@ -13,6 +13,7 @@ use std::sync::{Arc, Mutex};
 
 use image::RgbImage;
 
+use super::super::golden::CacheMode;
 use crate::atomic_write::write_file_atomic;
 use crate::case::Case;
 use crate::fault::FaultSet;
@@ -34,6 +35,8 @@ pub fn picture_name(picture: Picture) -> String {
 /// Every picture a rubric takes from one render, for any fault set.
 pub struct FaultPictures<'a> {
     dir: Option<PathBuf>,
+    /// Whether pictures rendered now are written to `dir`.
+    mode: CacheMode,
     renderer: FaultRenderer,
     golden: &'a Film,
     tonemap: Tonemap,
@@ -52,10 +55,12 @@ pub struct FaultPictures<'a> {
 }
 
 impl<'a> FaultPictures<'a> {
-    /// `dir`: this render's cache folder, or `None` to cache nothing; `pictures` those compared,
-    /// `stored` every picture of the render the rubric uses.
+    /// `dir`: this render's cache folder, or `None` to cache nothing (`mode` says whether it may
+    /// be written); `pictures` those compared, `stored` every picture of the render the rubric
+    /// uses.
     pub fn new(
         dir: Option<PathBuf>,
+        mode: CacheMode,
         case: &'a Case,
         golden: &'a Film,
         pictures: Vec<Picture>,
@@ -63,6 +68,7 @@ impl<'a> FaultPictures<'a> {
     ) -> Self {
         FaultPictures {
             dir,
+            mode,
             renderer: FaultRenderer::new(case),
             golden,
             tonemap: case.render.tonemap,
@@ -94,6 +100,9 @@ impl<'a> FaultPictures<'a> {
     /// Every picture of the render quantised and written to the cache (best effort: a cache that
     /// cannot be written costs a render next time, nothing more).
     fn store_all(&self, label: &str, film: &Film, faults: &FaultSet) {
+        if self.mode == CacheMode::ReadOnly {
+            return;
+        }
         for picture in &self.stored {
             let image = picture_with_faults(film, *picture, self.tonemap, faults);
             if let (Some(path), Ok(bytes)) = (self.entry(label, *picture), encode_png(&image)) {

@@ -1,0 +1,343 @@
+//! One grading run over a class, streamed: students are graded a batch at a time, each student's
+//! result written to the report as soon as the student is done (see `resume`), and only results
+//! (never pictures) kept until the class-wide report is written. Memory therefore does not grow
+//! with the class beyond a few kilobytes per student.
+
+use std::collections::BTreeMap;
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use rayon::prelude::*;
+
+use super::diagnose::{self, Diagnoser};
+use super::diagnosis::DiagnosisRun;
+use super::error::GradeError;
+use super::golden::{CacheMode, default_cache_dir, prepare_goldens, write_golden_pictures};
+use super::report::{self, ClassReport, RubricSummary};
+use super::resume::{StudentRecord, read_record, run_fingerprint, student_fingerprint, write_record};
+use super::rubric::load_rubric;
+use super::score::{StudentResult, Submission, grade_image};
+use super::shard::{Manifest, Shard, copy_pictures, read_shards, write_manifest};
+use super::similarity::{self, similar_pairs};
+use super::timing::{RunCost, Timings, timed};
+use super::{Diagnose, GradeOptions, html, integrity};
+use crate::film::OutputError;
+use crate::progress::Progress;
+
+/// Students graded (and diagnosed) together: enough to keep every core busy, few enough that
+/// their pictures, decoded for diagnosis, stay a bounded amount of memory.
+const BATCH: usize = 16;
+
+pub(super) fn grade(
+    rubric_path: &Path,
+    submissions: &Path,
+    options: &GradeOptions,
+    diagnose: Diagnose,
+    progress: &dyn Progress,
+) -> Result<ClassReport, GradeError> {
+    let started = Instant::now();
+    let rubric = load_rubric(rubric_path)?;
+    let out = &options.out;
+    let cache = options.cache.clone().unwrap_or_else(default_cache_dir);
+    let (folders, ignored) = student_folders(submissions, &[out, &cache])?;
+    let names: Vec<String> = folders.keys().cloned().collect();
+    let slugs = report::slugs(&names);
+    let range = options.shard.range(names.len());
+    let cache_mode = if options.shard == Shard::WHOLE {
+        CacheMode::ReadWrite
+    } else {
+        CacheMode::ReadOnly
+    };
+    let goldens = prepare_goldens(&rubric, &cache, cache_mode, progress)?;
+    write_golden_pictures(&rubric, &goldens, out)?;
+    let published = integrity::published_hashes(&rubric.integrity, rubric.images.iter().map(|spec| spec.file.as_str()));
+    let run = run_fingerprint(&rubric, &goldens, &published, diagnose);
+    let diagnoser = (diagnose == Diagnose::Yes).then(|| Diagnoser::new(&rubric, &goldens, &cache, cache_mode, out));
+
+    let mut cost = RunCost {
+        shards: 1,
+        ..RunCost::default()
+    };
+    let mut students: Vec<StudentResult> = Vec::with_capacity(range.len());
+    progress.begin("grading", range.len() as u64);
+    let indices: Vec<usize> = range.clone().collect();
+    for batch in indices.chunks(BATCH) {
+        // Each student reused or graded, one task per student and image.
+        let steps = batch
+            .par_iter()
+            .map(|&i| {
+                let submission = Submission::new(names[i].clone(), folders[&names[i]].clone(), slugs[i].clone());
+                let hashing = Instant::now();
+                let inputs = student_fingerprint(&run, &submission, &rubric);
+                let hashing = hashing.elapsed().as_secs_f64();
+                if !options.force
+                    && let Some(record) = read_record(out, &submission.slug, rubric.images.len())
+                    && record.run == run
+                    && record.inputs == inputs
+                {
+                    return Ok(Step::Reused(record));
+                }
+                // Pictures an earlier grading of this student left are no longer the student's.
+                let _ = fs::remove_dir_all(out.join(submission.dir()));
+                let graded = rubric
+                    .images
+                    .par_iter()
+                    .zip(&goldens.images)
+                    .map(|(spec, golden)| {
+                        let mut timings = Timings::default();
+                        let published = published.get(&spec.file).copied();
+                        grade_image(
+                            spec,
+                            golden,
+                            &submission,
+                            &rubric.integrity,
+                            published,
+                            out,
+                            &mut timings,
+                        )
+                        .map(|result| (result, timings))
+                    })
+                    .collect::<Result<Vec<_>, OutputError>>()?;
+                // Reading the files to fingerprint them counts as reading them.
+                let mut timings = Timings {
+                    decode: hashing,
+                    ..Timings::default()
+                };
+                for (_, t) in &graded {
+                    timings += *t;
+                }
+                let result = StudentResult::new(&submission, graded.into_iter().map(|(r, _)| r).collect());
+                Ok(Step::Graded {
+                    result,
+                    inputs,
+                    timings,
+                })
+            })
+            .collect::<Result<Vec<Step>, GradeError>>()?;
+
+        let (mut fresh, mut fresh_inputs, mut fresh_timings) = (Vec::new(), Vec::new(), Vec::new());
+        let mut order = Vec::new();
+        for step in steps {
+            match step {
+                Step::Reused(record) => {
+                    cost.reused += 1;
+                    order.push(Err(record.into_result()));
+                }
+                Step::Graded {
+                    result,
+                    inputs,
+                    timings,
+                } => {
+                    order.push(Ok(fresh.len()));
+                    fresh.push(result);
+                    fresh_inputs.push(inputs);
+                    fresh_timings.push(timings);
+                }
+            }
+        }
+        if let Some(diagnoser) = &diagnoser
+            && !fresh.is_empty()
+        {
+            let diagnosis_started = Instant::now();
+            diagnoser.diagnose(&mut fresh)?;
+            diagnose::prefer_consistent(&mut fresh);
+            diagnose::apply_credit(&rubric, &mut fresh);
+            let share = diagnosis_started.elapsed().as_secs_f64() / fresh.len() as f64;
+            for timings in &mut fresh_timings {
+                timings.diagnosis += share;
+            }
+        }
+        fresh
+            .par_iter()
+            .zip(fresh_inputs)
+            .zip(fresh_timings.par_iter_mut())
+            .map(|((result, inputs), timings)| {
+                let slug = result.page.strip_prefix("students/").unwrap_or(&result.page);
+                let slug = slug.strip_suffix(".html").unwrap_or(slug);
+                let record = StudentRecord::new(&run, inputs, result.clone(), *timings);
+                timed(&mut timings.report, || write_record(out, slug, &record))
+            })
+            .collect::<Result<Vec<()>, OutputError>>()?;
+        for timings in &fresh_timings {
+            cost.timings += *timings;
+        }
+        cost.graded += fresh.len();
+        let mut fresh = fresh.into_iter().map(Some).collect::<Vec<_>>();
+        for entry in order {
+            let (student, kept) = match entry {
+                Ok(index) => (fresh[index].take(), false),
+                Err(result) => (Some(result), true),
+            };
+            if let Some(student) = student {
+                progress.advance(1);
+                if kept {
+                    progress.done(&format!("{} (kept from an earlier run)", student.name));
+                } else {
+                    progress.done(&student.name);
+                }
+                students.push(student);
+            }
+        }
+    }
+    progress.finish();
+
+    let diagnosis = diagnoser.map(Diagnoser::run);
+    let slice_slugs = slugs[range].to_vec();
+    let mut report = ClassReport {
+        goldray: env!("CARGO_PKG_VERSION"),
+        rubric: RubricSummary::of(&rubric),
+        submissions: submissions.to_path_buf(),
+        cache: cache.clone(),
+        goldens: goldens.renders,
+        diagnosis,
+        ignored,
+        similar: Vec::new(),
+        students,
+        cost,
+    };
+    report.similar = find_similar(&report.students);
+    if options.shard == Shard::WHOLE {
+        write_report(&mut report, out, started)?;
+    } else {
+        report.cost.seconds = started.elapsed().as_secs_f64();
+        report::write_run(&report, out)?;
+    }
+    let manifest = Manifest {
+        goldray: report.goldray.to_owned(),
+        run,
+        shard: options.shard,
+        class: names,
+        slugs: slice_slugs,
+        rubric: report.rubric.clone(),
+        submissions: report.submissions.clone(),
+        cache: report.cache.clone(),
+        goldens: report.goldens.clone(),
+        ignored: report.ignored.clone(),
+        diagnosis: report.diagnosis.clone(),
+        cost: report.cost.clone(),
+    };
+    write_manifest(&manifest, out)?;
+    Ok(report)
+}
+
+/// A student of a batch: reused from an earlier run, or graded now (not yet diagnosed).
+enum Step {
+    Reused(StudentRecord),
+    Graded {
+        result: StudentResult,
+        inputs: String,
+        timings: Timings,
+    },
+}
+
+/// Combines the outputs of the N shards of a class (`shards`, in any order) into `out`: the
+/// students' pictures copied, and `grades.csv`, `grades.json`, `index.html` and the students'
+/// pages written as one run over the whole class writes them.
+pub(super) fn merge(out: &Path, shards: &[PathBuf]) -> Result<ClassReport, GradeError> {
+    let started = Instant::now();
+    let shards = read_shards(shards)?;
+    for shard in &shards {
+        copy_pictures(shard, out)?;
+    }
+    let first = &shards[0].manifest;
+    let mut cost = RunCost::default();
+    let mut diagnosis: Option<DiagnosisRun> = None;
+    for shard in &shards {
+        cost += &shard.manifest.cost;
+        if let Some(run) = &shard.manifest.diagnosis {
+            diagnosis.get_or_insert_with(DiagnosisRun::default).add(run);
+        }
+    }
+    let (rubric, submissions, cache, goldens, ignored) = (
+        first.rubric.clone(),
+        first.submissions.clone(),
+        first.cache.clone(),
+        first.goldens.clone(),
+        first.ignored.clone(),
+    );
+    let students: Vec<StudentResult> = shards
+        .into_iter()
+        .flat_map(|shard| shard.records)
+        .map(StudentRecord::into_result)
+        .collect();
+    let mut report = ClassReport {
+        goldray: env!("CARGO_PKG_VERSION"),
+        rubric,
+        submissions,
+        cache,
+        goldens,
+        diagnosis,
+        ignored,
+        similar: find_similar(&students),
+        students,
+        cost,
+    };
+    let shards_seconds = report.cost.seconds;
+    write_report(&mut report, out, started)?;
+    report.cost.seconds += shards_seconds;
+    report::write_run(&report, out)?;
+    Ok(report)
+}
+
+/// Writes the class-wide files: `grades.csv`, `grades.json`, the HTML pages and `run.json`.
+fn write_report(report: &mut ClassReport, out: &Path, started: Instant) -> Result<(), GradeError> {
+    let report_started = Instant::now();
+    report::write_data(report, out)?;
+    html::write_html(report, out)?;
+    report.cost.timings.report += report_started.elapsed().as_secs_f64();
+    report.cost.seconds = started.elapsed().as_secs_f64();
+    report::write_run(report, out)?;
+    Ok(())
+}
+
+/// Pairs of students who handed in the same (or nearly the same failing) picture.
+fn find_similar(students: &[StudentResult]) -> Vec<similarity::SimilarPair> {
+    similar_pairs(
+        &students
+            .iter()
+            .flat_map(|student| {
+                student.images.iter().enumerate().filter_map(|(order, image)| {
+                    Some(similarity::Entry {
+                        student: &student.name,
+                        file: &image.file,
+                        order,
+                        path: image.graded_file.as_deref()?,
+                        fingerprint: image.fingerprint.as_ref()?,
+                    })
+                })
+            })
+            .collect::<Vec<_>>(),
+    )
+}
+
+/// Student folders by name, and the names of the other entries. Hidden entries and `__MACOSX` are
+/// skipped silently, and so are the report and cache directories when they sit inside
+/// `submissions` (so that grading twice does not grade the first report).
+fn student_folders(
+    submissions: &Path,
+    own: &[&PathBuf],
+) -> Result<(BTreeMap<String, PathBuf>, Vec<String>), GradeError> {
+    let error = |source| GradeError::Submissions {
+        path: submissions.to_path_buf(),
+        source,
+    };
+    let own: Vec<PathBuf> = own.iter().filter_map(|p| p.canonicalize().ok()).collect();
+    let mut folders = BTreeMap::new();
+    let mut ignored = Vec::new();
+    for entry in fs::read_dir(submissions).map_err(error)? {
+        let entry = entry.map_err(error)?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let path = entry.path();
+        if name.starts_with('.') || name == "__MACOSX" || path.canonicalize().is_ok_and(|p| own.contains(&p)) {
+            continue;
+        }
+        if path.is_dir() {
+            folders.insert(name, path);
+        } else {
+            ignored.push(name);
+        }
+    }
+    ignored.sort();
+    Ok((folders, ignored))
+}
