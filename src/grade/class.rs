@@ -29,7 +29,11 @@ use crate::progress::Progress;
 /// their pictures, decoded for diagnosis, stay a bounded amount of memory.
 const BATCH: usize = 16;
 
-pub(super) fn grade(
+/// [`super::grade_class`], diagnosing or not. Students are streamed (in batches of [`BATCH`]); each one's result
+/// is kept in the report folder, and reused by the next run with the same inputs unless
+/// `options.force`. With a shard, only that slice is graded and the class-wide files are left to
+/// [`super::merge_shards`].
+pub fn grade(
     rubric_path: &Path,
     submissions: &Path,
     options: &GradeOptions,

@@ -101,19 +101,7 @@ pub fn grade_class(
     grade_class_diagnosing(rubric_path, submissions, options, Diagnose::Yes, progress)
 }
 
-/// [`grade_class`], diagnosing or not. Students are streamed (see [`class`]); each one's result
-/// is kept in the report folder, and reused by the next run with the same inputs unless
-/// `options.force`. With a shard, only that slice is graded and the class-wide files are left to
-/// [`merge_shards`].
-pub fn grade_class_diagnosing(
-    rubric_path: &Path,
-    submissions: &Path,
-    options: &GradeOptions,
-    diagnose: Diagnose,
-    progress: &dyn Progress,
-) -> Result<ClassReport, GradeError> {
-    class::grade(rubric_path, submissions, options, diagnose, progress)
-}
+pub use class::grade as grade_class_diagnosing;
 
 /// Combines the report folders of the N shards of a class into `out`, as one run over the whole
 /// class would have written it; refuses shards of different rubrics, golden renders or classes,

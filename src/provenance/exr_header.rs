@@ -5,7 +5,7 @@
 //! `i32` size and the value) ended by an empty name; the offset table that follows holds the
 //! absolute file position of each chunk, `chunkCount` of them.
 
-use super::{Group, ProvenanceError};
+use super::{Edit, ProvenanceError};
 
 /// Version-word flags of files this splicer refuses: deep data, and several parts (one header
 /// and offset table each).
@@ -87,14 +87,10 @@ pub(super) fn read(bytes: &[u8], file: &str) -> Result<Vec<(String, String)>, Pr
         .collect())
 }
 
-/// The file without the attributes of `group`, and with `entries` added as `string` attributes
-/// at the end of the header, in their order.
-pub(super) fn replace(
-    bytes: &[u8],
-    file: &str,
-    group: Group,
-    entries: &[(&str, &str)],
-) -> Result<Vec<u8>, ProvenanceError> {
+/// The file without the attributes of `edit.group`, and with `edit.entries` added as `string`
+/// attributes at the end of the header, in their order.
+pub(super) fn replace(bytes: &[u8], file: &str, edit: &Edit) -> Result<Vec<u8>, ProvenanceError> {
+    let Edit { group, entries } = *edit;
     let bad = |reason: &str| ProvenanceError::Exr {
         file: file.to_owned(),
         reason: reason.to_owned(),

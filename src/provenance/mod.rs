@@ -167,13 +167,32 @@ impl Provenance {
     /// `goldray.*` entries already there. `file` names the output in errors.
     pub fn stamp(&self, bytes: &[u8], file: &str) -> Result<Vec<u8>, ProvenanceError> {
         let entries: Vec<(&str, &str)> = self.entries().collect();
-        if bytes.starts_with(&EXR_MAGIC) {
-            exr_header::replace(bytes, file, Group::All, &entries)
-        } else if bytes.starts_with(&PNG_MAGIC) {
-            png_text::replace(bytes, file, Group::All, &entries)
-        } else {
-            Err(ProvenanceError::UnknownFormat { file: file.to_owned() })
-        }
+        replace(
+            bytes,
+            file,
+            &Edit {
+                group: Group::All,
+                entries: &entries,
+            },
+        )
+    }
+}
+
+/// What [`replace`] does to a file: removes the entries of `group`, then adds `entries`.
+#[derive(Clone, Copy)]
+struct Edit<'a> {
+    group: Group,
+    entries: &'a [(&'a str, &'a str)],
+}
+
+/// `bytes` edited in whichever format they are (EXR or PNG, by their magic number).
+fn replace(bytes: &[u8], file: &str, edit: &Edit) -> Result<Vec<u8>, ProvenanceError> {
+    if bytes.starts_with(&EXR_MAGIC) {
+        exr_header::replace(bytes, file, edit)
+    } else if bytes.starts_with(&PNG_MAGIC) {
+        png_text::replace(bytes, file, edit)
+    } else {
+        Err(ProvenanceError::UnknownFormat { file: file.to_owned() })
     }
 }
 
@@ -181,14 +200,7 @@ impl Provenance {
 /// determinism tests compare. An EXR's chunk offsets are shifted by what was removed, so the
 /// result is the file the encoder would have written without those entries.
 pub fn strip(bytes: &[u8], group: Group) -> Result<Vec<u8>, ProvenanceError> {
-    let file = "image data";
-    if bytes.starts_with(&EXR_MAGIC) {
-        exr_header::replace(bytes, file, group, &[])
-    } else if bytes.starts_with(&PNG_MAGIC) {
-        png_text::replace(bytes, file, group, &[])
-    } else {
-        Err(ProvenanceError::UnknownFormat { file: file.to_owned() })
-    }
+    replace(bytes, "image data", &Edit { group, entries: &[] })
 }
 
 /// The commit `build.rs` recorded (`GOLDRAY_GIT_COMMIT`): `None` when it recorded none, which is

@@ -4,7 +4,7 @@
 
 use std::io::Cursor;
 
-use super::{Group, ProvenanceError};
+use super::{Edit, ProvenanceError};
 
 const SIGNATURE: usize = 8;
 
@@ -92,14 +92,10 @@ pub(super) fn read(bytes: &[u8], file: &str) -> Result<Vec<(String, String)>, Pr
     Ok(entries)
 }
 
-/// The file without the text chunks of `group`, and with `entries` in text chunks right after
-/// the header chunk, in their order.
-pub(super) fn replace(
-    bytes: &[u8],
-    file: &str,
-    group: Group,
-    entries: &[(&str, &str)],
-) -> Result<Vec<u8>, ProvenanceError> {
+/// The file without the text chunks of `edit.group`, and with `edit.entries` in text chunks
+/// right after the header chunk, in their order.
+pub(super) fn replace(bytes: &[u8], file: &str, edit: &Edit) -> Result<Vec<u8>, ProvenanceError> {
+    let Edit { group, entries } = *edit;
     let chunks = chunks(bytes, file)?;
     let Some((b"IHDR", header)) = chunks.first().map(|(kind, span)| (kind, *span)) else {
         return Err(ProvenanceError::Png {
