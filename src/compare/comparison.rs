@@ -7,6 +7,7 @@ use serde::Serialize;
 
 use super::image::{COLOR_CHANNELS, Encoding, Image};
 use super::metrics::{Metrics, measure, same_layout};
+use super::noise::{self, Noise};
 use super::tolerance::Tolerance;
 use super::verdict::{Layout, Verdict, judge, percent};
 
@@ -18,12 +19,16 @@ pub struct Comparison {
     pub actual: PathBuf,
     pub tolerance: Tolerance,
     pub metrics: Option<Metrics>,
+    /// The statistical test, when both images carry the variance of their mean colour.
+    pub noise: Option<Noise>,
     pub verdict: Verdict,
     /// Where the caller wrote the diff heatmap, for the report to point at.
     pub diff_image: Option<PathBuf>,
 }
 
-/// Compares `actual` against `expected` under `tolerance`, in the images' own units.
+/// Compares `actual` against `expected` under `tolerance`, in the images' own units. When both
+/// are EXRs with variance channels (sampled renders), colour values with variance are judged by
+/// the statistical test of [`noise`](super::noise) and the rest by `tolerance`.
 ///
 /// A NaN limit counts as 0, the strictest: every comparison with NaN is false, so taken as given
 /// it would let any difference through.
@@ -35,22 +40,25 @@ pub fn compare(expected: &Image, actual: &Image, tolerance: &Tolerance) -> Compa
         rmse: strict(tolerance.rmse),
         max: tolerance.max.map(strict),
     };
-    let (metrics, verdict) = if same_layout(expected, actual) {
-        let metrics = measure(expected, actual, tolerance.pixel);
-        let verdict = judge(&metrics, tolerance);
-        (Some(metrics), verdict)
+    let (metrics, noise, verdict) = if same_layout(expected, actual) {
+        let sigmas = noise::sigmas(expected, actual);
+        let metrics = measure(expected, actual, tolerance.pixel, sigmas.as_deref());
+        let noise = sigmas.map(|sigmas| noise::test(expected, actual, &sigmas, tolerance));
+        let verdict = judge(&metrics, tolerance, noise.as_ref());
+        (Some(metrics), noise, verdict)
     } else {
         let verdict = Verdict::Mismatch {
             expected: Layout::of(expected),
             actual: Layout::of(actual),
         };
-        (None, verdict)
+        (None, None, verdict)
     };
     Comparison {
         expected: expected.source.clone(),
         actual: actual.source.clone(),
         tolerance: tolerance.clone(),
         metrics,
+        noise,
         verdict,
         diff_image: None,
     }
@@ -73,6 +81,7 @@ struct JsonReport<'a> {
     actual: &'a PathBuf,
     tolerance: JsonTolerance,
     metrics: &'a Option<Metrics>,
+    noise: &'a Option<Noise>,
     diff_image: &'a Option<PathBuf>,
 }
 
@@ -93,6 +102,7 @@ impl Comparison {
                 max: t.max,
             },
             metrics: &self.metrics,
+            noise: &self.noise,
             diff_image: &self.diff_image,
         };
         serde_json::to_string_pretty(&report)
@@ -120,28 +130,67 @@ impl fmt::Display for Comparison {
             }
             Verdict::Pass | Verdict::Warn => {}
         }
+        if let Some(noise) = &self.noise {
+            write_noise(f, noise)?;
+        }
         if let Some(metrics) = &self.metrics {
-            write_metrics(f, metrics)?;
+            write_metrics(f, metrics, self.noise.is_some())?;
         }
         if let Some(path) = &self.diff_image {
-            writeln!(
-                f,
-                "  diff heatmap: {} (magenta = failing pixel, cyan = NaN/inf)",
-                path.display()
-            )?;
+            let legend = if self.noise.is_some() {
+                "|z| from 1 (dark red) to the threshold (yellow); magenta = significant or failing, cyan = NaN/inf"
+            } else {
+                "magenta = failing pixel, cyan = NaN/inf"
+            };
+            writeln!(f, "  diff heatmap: {} ({legend})", path.display())?;
         }
         Ok(())
     }
 }
 
-fn write_metrics(f: &mut fmt::Formatter<'_>, m: &Metrics) -> fmt::Result {
+/// The statistical test's lines: what was tested, what it found, and what it could have found.
+fn write_noise(f: &mut fmt::Formatter<'_>, noise: &Noise) -> fmt::Result {
+    writeln!(
+        f,
+        "  statistical test: {} colour values with variance, Šidák-corrected Z test at α = {} \
+         (|z| over {:.2}); {} significant",
+        noise.tests, noise.alpha, noise.z_critical, noise.significant
+    )?;
+    if let Some(strongest) = &noise.strongest {
+        writeln!(
+            f,
+            "  strongest evidence: z = {:.2} at {} (σ {:.3e})",
+            strongest.z, strongest.at, strongest.sigma
+        )?;
+    }
+    let p = &noise.power;
+    let shift = |s: Option<f64>| s.map_or_else(|| "none".to_owned(), |s| format!("{s:.2e}"));
+    writeln!(
+        f,
+        "  power: detects with {:.0}% probability a shift of {} on every colour value, or of {} over a {}×{} \
+         area ({} where it sees least)",
+        p.probability * 100.0,
+        shift(p.uniform_shift),
+        shift(p.local_shift_median),
+        p.window,
+        p.window,
+        shift(p.local_shift_worst),
+    )
+}
+
+fn write_metrics(f: &mut fmt::Formatter<'_>, m: &Metrics, statistical: bool) -> fmt::Result {
     let units = match m.encoding {
         Encoding::Linear => "linear",
         Encoding::Code8 => "8-bit codes",
     };
+    let which = if statistical {
+        " (depth, normals and colour values without variance)"
+    } else {
+        ""
+    };
     writeln!(
         f,
-        "  failing pixels: {} of {} ({}) differ by more than {} ({units})",
+        "  failing pixels{which}: {} of {} ({}) differ by more than {} ({units})",
         m.failing_pixels,
         m.pixels,
         percent(m.failing_fraction),

@@ -22,14 +22,17 @@ mod flip;
 mod heatmap;
 mod image;
 mod metrics;
+pub mod noise;
+mod normal;
 mod tolerance;
 mod verdict;
 
 pub use comparison::{Comparison, compare};
 pub use error::CompareError;
 pub use files::{FileComparison, ToleranceOverrides, compare_files};
-pub use heatmap::{FAILING, NON_FINITE, diff_heatmap};
+pub use heatmap::{FAILING, NON_FINITE, comparison_heatmap, diff_heatmap, evidence_heatmap};
 pub use image::{COLOR_CHANNELS, Channel, Encoding, Image};
 pub use metrics::{ChannelStats, Metrics, NonFinite, PixelError};
+pub use noise::{Evidence, Noise, Power};
 pub use tolerance::{EXR_DEFAULTS, PNG_DEFAULTS, Tolerance};
 pub use verdict::{Breach, Layout, Limit, Verdict};

@@ -11,7 +11,7 @@ pub use self::error::OutputError;
 pub use self::exr::{VARIANCE_CHANNELS, decode_exr, encode_exr, read_exr, write_exr};
 pub use self::faults::{Picture, picture, picture_with_faults};
 pub use self::output::{OutputOptions, write_outputs};
-pub use self::png::{color_image, depth_image, encode_png, normals_image, write_png};
+pub use self::png::{color_image, depth_image, encode_png, normals_image, tone_curve, write_png};
 
 /// A rendered frame. Pixels are row-major with row 0 at the top of the picture.
 ///

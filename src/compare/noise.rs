@@ -1,0 +1,348 @@
+//! The statistical verdict: when both images carry the variance of each pixel's mean colour (EXRs
+//! of renders with several samples per pixel), a colour difference is judged against the noise
+//! the two renders could have made, not against a fixed threshold.
+//!
+//! **The test.** Each colour value (pixel × channel) is a two-sample Z test on the difference of
+//! the means: `z = (actual − expected) / σ` with `σ² = var_expected + var_actual`, the variances
+//! of the two means as the renders estimated them (see `render::moments`). The test is two-sided.
+//!
+//! **Multiple comparisons: Šidák.** A 128×128 picture is 49,152 tests; at a per-test 1% the suite
+//! would fail every run. The family of tests is held at [`FAMILY_ALPHA`] = 1% (the chance that a
+//! correct render fails) with Šidák's per-test level `1 − (1 − α)^(1/m)`. Šidák rather than
+//! Benjamini–Hochberg because the question is "is anything different at all?", which is the
+//! family-wise error BH does not control (it controls the share of false discoveries among the
+//! discoveries, useful when many pixels are expected to differ); because pixels are independent
+//! given the stateless sampler, where Šidák is exact (the three channels of one pixel are
+//! positively correlated, where it stays valid and slightly conservative); and because its fixed
+//! per-test threshold makes the power of the test a closed formula, which BH's data-dependent
+//! threshold does not.
+//!
+//! **Values with no variance in either image** (background, a flat surface the pixel covers
+//! whole, every sample alike) are not tested: they are judged by the tolerance's `pixel` rule, as
+//! in a deterministic render, and count towards `fail_fraction`. A zero estimate from few samples
+//! is not proof of no noise: an edge that the golden's samples all missed may be hit by another
+//! seed. But then the image whose samples hit it has the variance, and it covers the difference:
+//! one stray sample of `n` gives `z = 1`, `k` of them `√(k(n − 1)/(n − k))`, far below the Šidák
+//! threshold until the coverage itself differs. Both estimates are zero only when both images'
+//! samples each saw a single colour, and then a difference is no noise the renders could make.
+//!
+//! **The floor.** `σ` is never taken below `2⁻¹⁶ · max(1, |expected|, |actual|)` (1.5·10⁻⁵ for
+//! colours up to 1, about 260 `f32` ulps): a smooth surface's variance can be as small as its
+//! rounding, and a golden blessed by another build may differ from this one in the last bits.
+//! The floor keeps such differences from counting as evidence while any visible change (an 8-bit
+//! code is 0.004) stays hundreds of σ away.
+//!
+//! **Power.** Every verdict says what it could have seen: the smallest shift `δ`, added to every
+//! tested colour value of the whole picture or of an 8×8 area, that the test detects with 80%
+//! probability, `1 − Π_i P(|N(δ/σ_i, 1)| ≤ z*) ≥ 0.8`, with the deterministic values' rule
+//! included (a shift beyond `pixel` on more pixels than `fail_fraction` allows fails for sure).
+
+use rayon::prelude::*;
+use serde::Serialize;
+
+use super::image::{COLOR_CHANNELS, Encoding, Image};
+use super::metrics::PixelError;
+use super::normal;
+use super::tolerance::Tolerance;
+
+/// The chance that a render differing from its golden only by sampling noise fails.
+pub const FAMILY_ALPHA: f64 = 0.01;
+/// The detection probability the power figures are stated at.
+pub const POWER_PROBABILITY: f64 = 0.8;
+/// The side of the square area of the local power figure, in pixels.
+pub const POWER_WINDOW: u32 = 8;
+/// The smallest σ, relative to the larger of 1 and the two values (see the module documentation).
+pub const RELATIVE_FLOOR: f64 = 1.0 / 65536.0;
+
+/// The σ of each colour value's difference, `None` for values with no variance in either image.
+pub type Sigmas = Vec<[Option<f64>; 3]>;
+
+/// What the statistical test found and what it could have found.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Noise {
+    /// Family-wise: the chance that noise alone fails the comparison.
+    pub alpha: f64,
+    pub correction: &'static str,
+    /// Colour values tested (pixels × channels with variance in either image).
+    pub tests: usize,
+    /// Colour values with no variance in either image, judged by the `pixel` rule instead.
+    pub deterministic_values: usize,
+    /// The |z| a value must exceed to count as a difference.
+    pub z_critical: f64,
+    /// Values over `z_critical`.
+    pub significant: usize,
+    /// The value with the largest |z|; `None` when nothing was tested.
+    pub strongest: Option<Evidence>,
+    pub power: Power,
+}
+
+/// One tested colour value.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Evidence {
+    #[serde(flatten)]
+    pub at: PixelError,
+    pub sigma: f64,
+    pub z: f64,
+}
+
+/// The smallest shifts the test detects with `probability`; `None` where no shift would be
+/// detected (nothing tested and too few deterministic pixels to break `fail_fraction`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Power {
+    pub probability: f64,
+    /// Added to every colour value of the picture.
+    pub uniform_shift: Option<f64>,
+    /// The side of the square area of the local figures.
+    pub window: u32,
+    /// Added to every colour value of one `window × window` area: at the median area…
+    pub local_shift_median: Option<f64>,
+    /// …and at the area where the test sees least.
+    pub local_shift_worst: Option<f64>,
+}
+
+/// The σ of every colour value, when both images are linear and carry variance.
+pub fn sigmas(expected: &Image, actual: &Image) -> Option<Sigmas> {
+    if expected.encoding != Encoding::Linear || actual.encoding != Encoding::Linear {
+        return None;
+    }
+    let (ve, va) = (expected.variance.as_ref()?, actual.variance.as_ref()?);
+    let (e, a) = (colour_planes(expected)?, colour_planes(actual)?);
+    if ve.len() != expected.pixels() || va.len() != actual.pixels() || expected.pixels() != actual.pixels() {
+        return None;
+    }
+    Some(
+        (0..expected.pixels())
+            .map(|i| std::array::from_fn(|c| sigma(e[c][i], a[c][i], ve[i][c], va[i][c])))
+            .collect(),
+    )
+}
+
+/// The σ of one value's difference, or `None` when neither image has variance there. A variance
+/// that is not a finite non-negative number (from a damaged or foreign file) counts as none, so
+/// the value is held to the strict `pixel` rule rather than excused.
+pub fn sigma(expected: f32, actual: f32, var_expected: f32, var_actual: f32) -> Option<f64> {
+    let clean = |v: f32| if v.is_finite() && v > 0.0 { f64::from(v) } else { 0.0 };
+    let variance = clean(var_expected) + clean(var_actual);
+    if variance == 0.0 {
+        return None;
+    }
+    let scale = 1f64.max(f64::from(expected).abs()).max(f64::from(actual).abs());
+    let floor = if scale.is_finite() { RELATIVE_FLOOR * scale } else { 0.0 };
+    Some(variance.max(floor * floor).sqrt())
+}
+
+/// The R, G and B planes of an image.
+fn colour_planes(image: &Image) -> Option<[&[f32]; 3]> {
+    let plane = |name: &str| image.channels.iter().find(|c| c.name == name).map(|c| &c.values[..]);
+    Some([plane("R")?, plane("G")?, plane("B")?])
+}
+
+/// The z of every tested value (`None` for the deterministic ones and non-finite colours).
+pub fn z_scores(expected: &Image, actual: &Image, sigmas: &Sigmas) -> Vec<[Option<f64>; 3]> {
+    let (Some(e), Some(a)) = (colour_planes(expected), colour_planes(actual)) else {
+        return vec![[None; 3]; sigmas.len()];
+    };
+    sigmas
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            std::array::from_fn(|c| {
+                let (ev, av) = (e[c][i], a[c][i]);
+                let sigma = s[c].filter(|_| ev.is_finite() && av.is_finite())?;
+                Some((f64::from(av) - f64::from(ev)) / sigma)
+            })
+        })
+        .collect()
+}
+
+/// The |z| a value must exceed for `tests` tests held together at `alpha`, two-sided.
+pub fn critical_z(alpha: f64, tests: usize) -> f64 {
+    let per_test = -(((-alpha).ln_1p()) / tests.max(1) as f64).exp_m1();
+    normal::upper_quantile(per_test / 2.0)
+}
+
+/// Runs the test on images whose `sigmas` were computed by [`sigmas`].
+pub fn test(expected: &Image, actual: &Image, sigmas: &Sigmas, tolerance: &Tolerance) -> Noise {
+    let tests = sigmas.iter().flatten().filter(|s| s.is_some()).count();
+    let deterministic_values = sigmas.len() * 3 - tests;
+    let z_critical = critical_z(FAMILY_ALPHA, tests);
+    let width = expected.width as usize;
+    let mut significant = 0;
+    let mut strongest: Option<Evidence> = None;
+    for (i, zs) in z_scores(expected, actual, sigmas).iter().enumerate() {
+        for (c, z) in zs.iter().enumerate() {
+            let Some(z) = *z else { continue };
+            significant += usize::from(z.abs() > z_critical);
+            if strongest.is_none_or(|s| z.abs() > s.z.abs()) {
+                let value = |image: &Image| {
+                    let plane = image.channels.iter().find(|ch| ch.name == COLOR_CHANNELS[c]);
+                    plane.map_or(f32::NAN, |ch| ch.values[i])
+                };
+                strongest = Some(Evidence {
+                    at: PixelError {
+                        x: (i % width) as u32,
+                        y: (i / width) as u32,
+                        channel: COLOR_CHANNELS[c],
+                        expected: value(expected),
+                        actual: value(actual),
+                    },
+                    sigma: sigmas[i][c].unwrap_or(0.0),
+                    z,
+                });
+            }
+        }
+    }
+    Noise {
+        alpha: FAMILY_ALPHA,
+        correction: "sidak",
+        tests,
+        deterministic_values,
+        z_critical,
+        significant,
+        strongest,
+        power: power(expected.width, expected.height, sigmas, z_critical, tolerance),
+    }
+}
+
+/// What a shift of the colour must overcome in one area: the σ of its tested values and the
+/// deterministic pixels that fail as soon as the shift passes `pixel`.
+struct Area {
+    sigmas: Vec<f64>,
+    deterministic_pixels: usize,
+}
+
+struct Rule {
+    z_critical: f64,
+    pixel: f64,
+    /// Failing pixels `fail_fraction` allows.
+    allowed: usize,
+}
+
+impl Area {
+    fn of(sigmas: &Sigmas, pixels: impl Iterator<Item = usize>) -> Area {
+        let mut area = Area {
+            sigmas: Vec::new(),
+            deterministic_pixels: 0,
+        };
+        for i in pixels {
+            area.sigmas.extend(sigmas[i].iter().flatten());
+            area.deterministic_pixels += usize::from(sigmas[i].iter().any(Option::is_none));
+        }
+        area
+    }
+
+    /// The chance that a shift of `delta` on every value of the area is detected.
+    fn detection(&self, delta: f64, rule: &Rule) -> f64 {
+        if delta > rule.pixel && self.deterministic_pixels > rule.allowed {
+            return 1.0;
+        }
+        let log_missed: f64 = self
+            .sigmas
+            .iter()
+            .map(|sigma| {
+                let shift = delta / sigma;
+                let escapes = normal::upper_tail(rule.z_critical - shift) + normal::cdf(-rule.z_critical - shift);
+                (-escapes.min(1.0)).ln_1p()
+            })
+            .sum();
+        -log_missed.exp_m1()
+    }
+
+    /// The smallest shift detected with [`POWER_PROBABILITY`], to 10⁻⁸ relative.
+    fn smallest_shift(&self, rule: &Rule) -> Option<f64> {
+        let (mut low, mut high) = (1e-12_f64, 1e3_f64);
+        if self.detection(high, rule) < POWER_PROBABILITY {
+            return None;
+        }
+        for _ in 0..32 {
+            let middle = (low * high).sqrt();
+            if self.detection(middle, rule) >= POWER_PROBABILITY {
+                high = middle;
+            } else {
+                low = middle;
+            }
+        }
+        Some(high)
+    }
+}
+
+fn power(width: u32, height: u32, sigmas: &Sigmas, z_critical: f64, tolerance: &Tolerance) -> Power {
+    let rule = Rule {
+        z_critical,
+        pixel: tolerance.pixel,
+        allowed: (tolerance.fail_fraction * sigmas.len() as f64).floor() as usize,
+    };
+    let (w, h) = (width as usize, height as usize);
+    let uniform_shift = Area::of(sigmas, 0..sigmas.len()).smallest_shift(&rule);
+    let side = POWER_WINDOW as usize;
+    let (across, down) = ((w / side).max(1), (h / side).max(1));
+    let (sw, sh) = (side.min(w), side.min(h));
+    let mut local: Vec<Option<f64>> = (0..across * down)
+        .into_par_iter()
+        .map(|k| {
+            let (x0, y0) = ((k % across) * sw, (k / across) * sh);
+            let pixels = (y0..y0 + sh).flat_map(|y| (x0..x0 + sw).map(move |x| y * w + x));
+            Area::of(sigmas, pixels).smallest_shift(&rule)
+        })
+        .collect();
+    // Undetectable areas last: `None` stands for an infinite shift.
+    local.sort_by(|a, b| a.unwrap_or(f64::INFINITY).total_cmp(&b.unwrap_or(f64::INFINITY)));
+    Power {
+        probability: POWER_PROBABILITY,
+        uniform_shift,
+        window: POWER_WINDOW,
+        local_shift_median: local.get(local.len() / 2).copied().flatten(),
+        local_shift_worst: local.last().copied().flatten(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sidak_threshold_grows_with_the_number_of_tests() {
+        assert!((critical_z(0.05, 1) - 1.959_963_984_540_054).abs() < 1e-9);
+        let many = critical_z(0.01, 49_152);
+        assert!((5.0..5.5).contains(&many), "{many}");
+    }
+
+    #[test]
+    fn no_variance_on_either_side_is_not_tested_and_the_floor_holds() {
+        assert_eq!(sigma(0.5, 0.6, 0.0, 0.0), None);
+        assert_eq!(sigma(0.5, 0.6, f32::NAN, -1.0), None);
+        assert_eq!(sigma(0.5, 0.5, 1e-30, 0.0), Some(RELATIVE_FLOOR));
+        let expected = (f64::from(0.01_f32) + f64::from(0.03_f32)).sqrt();
+        assert_eq!(sigma(0.5, 0.5, 0.01, 0.03), Some(expected));
+    }
+
+    #[test]
+    fn power_shrinks_with_the_noise_and_grows_with_the_area() {
+        let rule = Rule {
+            z_critical: 5.0,
+            pixel: 0.01,
+            allowed: 16,
+        };
+        let area = |sigma: f64, n: usize| Area {
+            sigmas: vec![sigma; n],
+            deterministic_pixels: 0,
+        };
+        let one = area(0.01, 1).smallest_shift(&rule).unwrap();
+        // One value: detected 80% of the time at about z* + 0.84 σ.
+        assert!((one / 0.01 - 5.84).abs() < 0.01, "{one}");
+        assert!(area(0.001, 1).smallest_shift(&rule).unwrap() < one / 9.0);
+        assert!(area(0.01, 64).smallest_shift(&rule).unwrap() < one);
+        // Deterministic pixels beyond the allowance make any shift over `pixel` a failure.
+        let flat = Area {
+            sigmas: Vec::new(),
+            deterministic_pixels: 17,
+        };
+        let shift = flat.smallest_shift(&rule).unwrap();
+        assert!((shift / 0.01 - 1.0).abs() < 1e-6, "{shift}");
+        let few = Area {
+            sigmas: Vec::new(),
+            deterministic_pixels: 16,
+        };
+        assert_eq!(few.smallest_shift(&rule), None);
+    }
+}
