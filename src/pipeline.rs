@@ -10,7 +10,7 @@ use crate::case::{
 };
 use crate::error::Error;
 use crate::film::{Film, OutputOptions, write_outputs};
-use crate::options::{Profile, RenderOptions, Spawn};
+use crate::options::{Profile, RenderOptions, Seeding, Spawn};
 use crate::progress::{Progress, Silent};
 use crate::stats::{BuildStats, Phases, RayCounts, RenderStats};
 use crate::with_precision;
@@ -87,6 +87,7 @@ pub fn render_options(case: &Case) -> RenderOptions {
             Profile::Native => Spawn::ErrorBounds,
             Profile::Mit6837 => Spawn::Course,
         },
+        seeding: Seeding::Seeded,
         aovs: true,
     }
 }

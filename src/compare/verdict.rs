@@ -15,8 +15,8 @@ use std::fmt;
 
 use serde::Serialize;
 
-use super::image::{Encoding, Image};
 use super::image::COLOR_CHANNELS;
+use super::image::{Encoding, Image};
 use super::metrics::{ChannelStats, Metrics, PixelError, largest};
 use super::noise::Noise;
 use super::tolerance::Tolerance;

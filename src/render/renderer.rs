@@ -56,7 +56,7 @@ fn render_counted<C: RayCounter, F: FaultPolicy>(
     faults: F,
     progress: &dyn Progress,
 ) -> (Film, C) {
-    let sampler = Sampler::new(options.trace.samples, options.trace.seed);
+    let sampler = Sampler::with_seeding(options.trace.samples, options.trace.seed, options.seeding);
     if sampler.samples_per_pixel() > 1 {
         render_pixels::<C, F, WithVariance>(scene, options, sampler, faults, progress)
     } else {

@@ -3,19 +3,26 @@
 //! picture is bit-identical.
 
 use super::real::{Real, Vec2};
+use crate::options::Seeding;
 
 #[derive(Clone, Copy, Debug)]
 pub struct Sampler {
     /// Samples per side of the pixel's `n × n` strata.
     strata: u32,
     seed: u64,
+    seeding: Seeding,
 }
 
 impl Sampler {
     /// `samples` must be a perfect square (the case loader checks); 1 means the pixel centre.
     pub fn new(samples: u32, seed: u64) -> Sampler {
+        Sampler::with_seeding(samples, seed, Seeding::Seeded)
+    }
+
+    /// [`Sampler::new`] with the random numbers drawn as `seeding` says.
+    pub fn with_seeding(samples: u32, seed: u64, seeding: Seeding) -> Sampler {
         let strata = (samples as f64).sqrt().round().max(1.0) as u32;
-        Sampler { strata, seed }
+        Sampler { strata, seed, seeding }
     }
 
     pub fn samples_per_pixel(&self) -> u32 {
@@ -27,6 +34,10 @@ impl Sampler {
     pub fn offset(&self, x: u32, y: u32, index: u32) -> Vec2 {
         if self.strata == 1 {
             return Vec2::splat(0.5);
+        }
+        if self.seeding == Seeding::PixelIndex {
+            let hash = mix(mix(0x9e37_79b9_7f4a_7c15, x as u64), y as u64);
+            return Vec2::new(unit_interval(hash), unit_interval(mix(hash, 0x5bd1_e995)));
         }
         let n = self.strata as Real;
         let hash = mix(mix(mix(self.seed ^ 0x9e37_79b9_7f4a_7c15, x as u64), y as u64), index as u64);
