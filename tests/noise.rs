@@ -16,9 +16,11 @@ use rayon::prelude::*;
 
 use goldray::case::{Case, LoadOptions, load, parse};
 use goldray::compare::{FAILING, Image, Limit, Verdict, evidence_heatmap};
-use goldray::film::{VARIANCE_CHANNELS, decode_exr, encode_exr, write_exr};
+use goldray::film::{VARIANCE_CHANNELS, color_image, decode_exr, encode_exr, write_exr, write_png};
+use goldray::grade::{Diagnose, GradeOptions, Outcome, grade_class_diagnosing, load_rubric};
 use goldray::options::Seeding;
 use goldray::pipeline::render_case;
+use goldray::progress::Silent;
 
 use planted::{Bug, judge, render, reseeded, resized};
 
@@ -288,4 +290,83 @@ fn diff_states_the_test_and_its_power() {
     );
     assert!(power["local_shift_median"].as_f64().is_some(), "{json}");
     assert_eq!(report["noise"]["correction"], "sidak");
+}
+
+/// A rubric's `statistical = true`: a student's jittered picture at another seed gets full
+/// points, the same picture without the option does not (its noise breaks a tight threshold),
+/// and a planted bug fails with it.
+#[test]
+fn a_statistical_rubric_passes_another_seed_and_fails_a_planted_bug() {
+    let case = sampled_cases()
+        .into_iter()
+        .find(|c| c.name == "jitter")
+        .expect("cases/jitter.toml");
+    let dir = tempfile::tempdir().unwrap();
+    let rubric = dir.path().join("rubric.toml");
+    let case_path = Path::new(ROOT).join("cases/jitter.toml");
+    std::fs::write(
+        &rubric,
+        format!(
+            "[defaults]\nthreshold = 2\npass_fraction = 0.001\npartial_fraction = 0.002\n\
+             [render.jitter]\ncase = {:?}\n\
+             [image.\"noisy.png\"]\nrender = \"jitter\"\nstatistical = true\n\
+             [image.\"plain.png\"]\nrender = \"jitter\"\n",
+            case_path.display().to_string()
+        ),
+    )
+    .unwrap();
+    let submissions = dir.path().join("submissions");
+    let (buggy, seeding) = Bug::DroppedLight.apply(&case).unwrap();
+    for (student, case, seeding) in [("reseeded", &case, Seeding::Seeded), ("no-light", &buggy, seeding)] {
+        let picture = color_image(&render(&reseeded(case, 8), seeding), case.render.tonemap);
+        for file in ["noisy.png", "plain.png"] {
+            write_png(&submissions.join(student).join(file), &picture).unwrap();
+        }
+    }
+    let options = GradeOptions {
+        out: dir.path().join("report"),
+        cache: Some(dir.path().join("cache")),
+    };
+    let report = grade_class_diagnosing(&rubric, &submissions, &options, Diagnose::No, &Silent).unwrap();
+    let outcome = |student: &str, image: usize| {
+        let result = report.students.iter().find(|s| s.name == student).expect("graded");
+        (
+            result.images[image].outcome.clone(),
+            result.images[image].explanation.clone(),
+        )
+    };
+    let (noisy, why) = outcome("reseeded", 0);
+    assert_eq!(noisy, Outcome::Pass, "{why}");
+    assert!(why.contains("plus the golden's sampling noise"), "{why}");
+    let (plain, why) = outcome("reseeded", 1);
+    assert_ne!(
+        plain,
+        Outcome::Pass,
+        "without the option, the noise alone should cost points: {why}"
+    );
+    let (bug, why) = outcome("no-light", 0);
+    assert_eq!(bug, Outcome::Fail, "{why}");
+}
+
+#[test]
+fn statistical_on_a_render_with_one_sample_is_a_located_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let rubric = dir.path().join("rubric.toml");
+    let case_path = Path::new(ROOT).join("cases/spheres_shadows.toml");
+    let text = format!(
+        "[render.plain]\ncase = {:?}\n[image.\"a.png\"]\nrender = \"plain\"\nstatistical = true\n",
+        case_path.display().to_string()
+    );
+    std::fs::write(&rubric, &text).unwrap();
+    let error = load_rubric(&rubric).unwrap_err().to_string();
+    assert!(error.contains("rubric.toml:5:1"), "{error}");
+    assert!(error.contains("several samples per pixel"), "{error}");
+    // From [defaults], the option applies where it can and leaves the others to the threshold.
+    let inherited = format!(
+        "[defaults]\nstatistical = true\n[render.plain]\ncase = {:?}\n[image.\"a.png\"]\nrender = \"plain\"\n",
+        case_path.display().to_string()
+    );
+    std::fs::write(&rubric, inherited).unwrap();
+    let loaded = load_rubric(&rubric).unwrap_or_else(|e| panic!("{e}"));
+    assert!(!loaded.images[0].rule.statistical);
 }

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use serde::Serialize;
 
 use super::image::{COLOR_CHANNELS, Encoding, Image};
-use super::metrics::{Metrics, measure, same_layout};
+use super::metrics::{ColourRule, Metrics, measure, same_layout};
 use super::noise::{self, Noise};
 use super::tolerance::Tolerance;
 use super::verdict::{Layout, Verdict, judge, percent};
@@ -33,6 +33,17 @@ pub struct Comparison {
 /// A NaN limit counts as 0, the strictest: every comparison with NaN is false, so taken as given
 /// it would let any difference through.
 pub fn compare(expected: &Image, actual: &Image, tolerance: &Tolerance) -> Comparison {
+    compare_with(expected, actual, tolerance, None)
+}
+
+/// [`compare`] of two images without variance (a student's 8-bit picture against the golden's),
+/// each colour value's `pixel` threshold widened by its `allowance` (see
+/// [`noise::png_allowance`]): the statistical verdict where only the golden knows its noise.
+pub fn compare_widened(expected: &Image, actual: &Image, tolerance: &Tolerance, allowance: &[[f32; 3]]) -> Comparison {
+    compare_with(expected, actual, tolerance, Some(allowance))
+}
+
+fn compare_with(expected: &Image, actual: &Image, tolerance: &Tolerance, allowance: Option<&[[f32; 3]]>) -> Comparison {
     let strict = |limit: f64| if limit.is_nan() { 0.0 } else { limit };
     let tolerance = &Tolerance {
         pixel: strict(tolerance.pixel),
@@ -40,9 +51,15 @@ pub fn compare(expected: &Image, actual: &Image, tolerance: &Tolerance) -> Compa
         rmse: strict(tolerance.rmse),
         max: tolerance.max.map(strict),
     };
+    let widened = allowance.filter(|a| a.len() == expected.pixels());
     let (metrics, noise, verdict) = if same_layout(expected, actual) {
-        let sigmas = noise::sigmas(expected, actual);
-        let metrics = measure(expected, actual, tolerance.pixel, sigmas.as_deref());
+        let sigmas = noise::sigmas(expected, actual).filter(|_| widened.is_none());
+        let colour = match (&sigmas, widened) {
+            (_, Some(allowance)) => ColourRule::Widened(allowance),
+            (Some(sigmas), None) => ColourRule::Tested(sigmas),
+            (None, None) => ColourRule::Threshold,
+        };
+        let metrics = measure(expected, actual, tolerance.pixel, colour);
         let noise = sigmas.map(|sigmas| noise::test(expected, actual, &sigmas, tolerance));
         let verdict = judge(&metrics, tolerance, noise.as_ref());
         (Some(metrics), noise, verdict)

@@ -15,8 +15,8 @@
 use image::{Rgb, RgbImage};
 
 use super::comparison::Comparison;
-use super::image::Image;
-use super::metrics::{Difference, difference};
+use super::image::{COLOR_CHANNELS, Image};
+use super::metrics::{ColourRule, Difference, difference};
 use super::noise::{self, Noise};
 
 pub const FAILING: [u8; 3] = [255, 0, 255];
@@ -29,6 +29,24 @@ const BACKDROP: f32 = 0.3;
 
 /// `None` when the images cannot be laid over each other (different sizes or channels).
 pub fn diff_heatmap(expected: &Image, actual: &Image, pixel_threshold: f64) -> Option<RgbImage> {
+    heatmap_with(expected, actual, pixel_threshold, ColourRule::Threshold)
+}
+
+/// [`diff_heatmap`] of a [`super::compare_widened`] comparison: a colour value is magenta when it
+/// differs by more than the threshold plus its allowance.
+pub fn diff_heatmap_widened(
+    expected: &Image,
+    actual: &Image,
+    pixel_threshold: f64,
+    allowance: &[[f32; 3]],
+) -> Option<RgbImage> {
+    if allowance.len() != expected.pixels() {
+        return None;
+    }
+    heatmap_with(expected, actual, pixel_threshold, ColourRule::Widened(allowance))
+}
+
+fn heatmap_with(expected: &Image, actual: &Image, pixel_threshold: f64, colour: ColourRule) -> Option<RgbImage> {
     if !super::metrics::same_layout(expected, actual) {
         return None;
     }
@@ -38,10 +56,14 @@ pub fn diff_heatmap(expected: &Image, actual: &Image, pixel_threshold: f64) -> O
         let mut largest = 0.0_f64;
         let mut failing = false;
         for (e, a) in expected.channels.iter().zip(&actual.channels) {
+            let colour_index = COLOR_CHANNELS.iter().position(|&c| c == e.name);
             match difference(e.values[i], a.values[i], e.infinity_is_a_value()) {
                 Difference::Broken => return Rgb(NON_FINITE),
                 diff @ (Difference::Finite(_) | Difference::Coverage) => {
-                    failing |= diff.exceeds(pixel_threshold);
+                    failing |= match colour_index {
+                        Some(c) => colour.fails(diff, pixel_threshold, i, c),
+                        None => diff.exceeds(pixel_threshold),
+                    };
                     if let Difference::Finite(d) = diff {
                         largest = largest.max(d);
                     }

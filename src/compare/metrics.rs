@@ -104,14 +104,32 @@ pub struct Metrics {
 
 /// Both images must have the same size and channel list (`compare` checks that first).
 ///
-/// With `tested` (the statistical verdict's σ per colour value), a colour value with a σ is left
-/// to the statistical test: it is measured (MAE, RMSE, worst) but never counts as failing.
-pub(super) fn measure(
-    expected: &Image,
-    actual: &Image,
-    pixel_threshold: f64,
-    tested: Option<&[[Option<f64>; 3]]>,
-) -> Metrics {
+/// How a colour value is held to the pixel threshold.
+#[derive(Clone, Copy)]
+pub(super) enum ColourRule<'a> {
+    /// Every value, as any other channel.
+    Threshold,
+    /// A value with a σ (the statistical verdict's) is left to the statistical test: it is
+    /// measured (MAE, RMSE, worst) but never counts as failing.
+    Tested(&'a [[Option<f64>; 3]]),
+    /// Each value's threshold is widened by its allowance (a golden's noise, in the images' units).
+    Widened(&'a [[f32; 3]]),
+}
+
+impl ColourRule<'_> {
+    /// Whether colour channel `c` of pixel `i` fails with `diff` under `threshold`.
+    pub(super) fn fails(self, diff: Difference, threshold: f64, i: usize, c: usize) -> bool {
+        match self {
+            ColourRule::Threshold => diff.exceeds(threshold),
+            ColourRule::Tested(tested) => tested[i][c].is_none() && diff.exceeds(threshold),
+            ColourRule::Widened(allowance) => diff.exceeds(threshold + f64::from(allowance[i][c])),
+        }
+    }
+}
+
+/// Both images must have the same size and channel list (`compare` checks that first); colour
+/// values are held to the threshold as `colour` says.
+pub(super) fn measure(expected: &Image, actual: &Image, pixel_threshold: f64, colour: ColourRule) -> Metrics {
     let width = expected.width as usize;
     let pixels = expected.pixels();
     let mut failing = vec![false; pixels];
@@ -122,10 +140,6 @@ pub(super) fn measure(
     for (e, a) in expected.channels.iter().zip(&actual.channels) {
         let color_index = COLOR_CHANNELS.iter().position(|&c| c == e.name);
         let is_color = color_index.is_some();
-        let judged_here = |i: usize| match (tested, color_index) {
-            (Some(tested), Some(c)) => tested[i][c].is_none(),
-            _ => true,
-        };
         let mut stats = ChannelStats {
             name: e.name,
             failing: 0,
@@ -141,7 +155,11 @@ pub(super) fn measure(
                 actual: av,
             };
             let diff = difference(ev, av, e.infinity_is_a_value());
-            if diff.exceeds(pixel_threshold) && judged_here(i) {
+            let fails = match color_index {
+                Some(c) => colour.fails(diff, pixel_threshold, i, c),
+                None => diff.exceeds(pixel_threshold),
+            };
+            if fails {
                 stats.failing += 1;
                 failing[i] = true;
             }

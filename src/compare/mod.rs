@@ -27,10 +27,10 @@ mod normal;
 mod tolerance;
 mod verdict;
 
-pub use comparison::{Comparison, compare};
+pub use comparison::{Comparison, compare, compare_widened};
 pub use error::CompareError;
 pub use files::{FileComparison, ToleranceOverrides, compare_files};
-pub use heatmap::{FAILING, NON_FINITE, comparison_heatmap, diff_heatmap, evidence_heatmap};
+pub use heatmap::{FAILING, NON_FINITE, comparison_heatmap, diff_heatmap, diff_heatmap_widened, evidence_heatmap};
 pub use image::{COLOR_CHANNELS, Channel, Encoding, Image};
 pub use metrics::{ChannelStats, Metrics, NonFinite, PixelError};
 pub use noise::{Evidence, Noise, Power};

@@ -44,6 +44,7 @@ use super::image::{COLOR_CHANNELS, Encoding, Image};
 use super::metrics::PixelError;
 use super::normal;
 use super::tolerance::Tolerance;
+use crate::film::{Film, Tonemap, tone_curve};
 
 /// The chance that a render differing from its golden only by sampling noise fails.
 pub const FAMILY_ALPHA: f64 = 0.01;
@@ -53,6 +54,54 @@ pub const POWER_PROBABILITY: f64 = 0.8;
 pub const POWER_WINDOW: u32 = 8;
 /// The smallest σ, relative to the larger of 1 and the two values (see the module documentation).
 pub const RELATIVE_FLOOR: f64 = 1.0 / 65536.0;
+
+/// How far each colour value of a student's 8-bit picture may stray from the golden picture
+/// because of sampling noise, in 8-bit codes: what a rubric's `statistical = true` adds to its
+/// `threshold` (see README, "The rubric").
+///
+/// A student's jittered picture has no variance channel, so its noise is estimated from the
+/// golden's: the student's mean is assumed as noisy as the golden's (the same sample count),
+/// which makes the difference's variance `2·var` in linear values, where `var` is the largest
+/// variance of the golden's 3×3 neighbourhood of the pixel. The neighbourhood is the floor a
+/// zero estimate needs here: where the golden's samples all missed an edge that clips the pixel,
+/// the golden has no variance, but the student's samples may hit it; the edge runs on through a
+/// neighbour, where the golden's samples did see it. (In an EXR comparison the image whose
+/// samples hit the edge carries that variance itself.) It is converted to codes
+/// through the tone map around the golden's mean, `σ_code = (T(m + σ) − T(m − σ)) / 2`, which
+/// follows the sRGB curve's slope and is 0 where the colour is clamped; the allowance is
+/// [`critical_z`] of the values with variance (Šidák at [`FAMILY_ALPHA`]) times `σ_code`.
+/// `None` when the film has no variance.
+pub fn png_allowance(film: &Film, tonemap: Tonemap) -> Option<Vec<[f32; 3]>> {
+    let variance = film.variance.as_ref()?;
+    let (w, h) = (film.width as usize, film.height as usize);
+    let neighbourhood = |i: usize| -> [f32; 3] {
+        let (x, y) = (i % w, i / w);
+        let mut largest = [0.0_f32; 3];
+        for ny in y.saturating_sub(1)..(y + 2).min(h) {
+            for nx in x.saturating_sub(1)..(x + 2).min(w) {
+                let v = variance[ny * w + nx];
+                largest = std::array::from_fn(|c| if v[c] > largest[c] { v[c] } else { largest[c] });
+            }
+        }
+        largest
+    };
+    let widened: Vec<[f32; 3]> = (0..variance.len()).map(neighbourhood).collect();
+    let noisy = widened.iter().flatten().filter(|&&v| v > 0.0).count();
+    let z = critical_z(FAMILY_ALPHA, noisy);
+    Some(
+        film.color
+            .iter()
+            .zip(&widened)
+            .map(|(mean, var)| {
+                std::array::from_fn(|c| {
+                    let sigma = (2.0 * f64::from(var[c])).sqrt() as f32;
+                    let spread = tone_curve(mean[c] + sigma, tonemap) - tone_curve(mean[c] - sigma, tonemap);
+                    (z * f64::from(spread / 2.0)) as f32
+                })
+            })
+            .collect(),
+    )
+}
 
 /// The σ of each colour value's difference, `None` for values with no variance in either image.
 pub type Sigmas = Vec<[Option<f64>; 3]>;

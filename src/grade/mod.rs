@@ -120,6 +120,7 @@ pub fn grade_class_diagnosing(
             let result = grade_image(
                 spec,
                 &goldens.images[image],
+                goldens.allowances[image].as_deref().map(Vec::as_slice),
                 &folders[student],
                 &rubric.integrity,
                 published.get(&spec.file).copied(),

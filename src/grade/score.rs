@@ -13,7 +13,7 @@ use super::rubric::{ImageSpec, Rule};
 use super::similarity::Fingerprint;
 use super::submission::{Folder, read_png};
 use crate::atomic_write::write_file_atomic;
-use crate::compare::{Image, Metrics, Tolerance, compare, diff_heatmap};
+use crate::compare::{Image, Metrics, Tolerance, compare, compare_widened, diff_heatmap, diff_heatmap_widened};
 use crate::film::{OutputError, encode_png, write_png};
 
 /// One expected file of one student.
@@ -111,9 +111,13 @@ impl StudentResult {
 /// the result is a verdict; only a failure to write the report is an error.
 /// Grades one expected file of one student. `published` is the pixel hash of the published
 /// reference image of this file, when the rubric names a published folder that has it.
+///
+/// `allowance` (a rubric's `statistical = true`): each colour value's threshold is widened by
+/// the golden's sampling noise, in codes (`compare::noise::png_allowance`).
 pub fn grade_image(
     spec: &ImageSpec,
     golden: &Image,
+    allowance: Option<&[[f32; 3]]>,
     submission: &Submission,
     integrity: &Integrity,
     published: Option<u64>,
@@ -164,7 +168,11 @@ pub fn grade_image(
         rmse: f64::INFINITY,
         max: None,
     };
-    let Some(metrics) = compare(golden, &actual, &tolerance).metrics else {
+    let compared = match allowance {
+        Some(allowance) => compare_widened(golden, &actual, &tolerance, allowance),
+        None => compare(golden, &actual, &tolerance),
+    };
+    let Some(metrics) = compared.metrics else {
         // Both pictures are 8-bit RGB, so only their sizes can keep them from being compared.
         write_file_atomic(&out.join(&copy), &encode_png(&actual.preview)?)?;
         result.student_image = Some(copy);
@@ -188,7 +196,11 @@ pub fn grade_image(
     } else {
         write_file_atomic(&out.join(&copy), &encode_png(&actual.preview)?)?;
         result.student_image = Some(copy);
-        if let Some(heatmap) = diff_heatmap(golden, &actual, spec.rule.threshold) {
+        let heatmap = match allowance {
+            Some(allowance) => diff_heatmap_widened(golden, &actual, spec.rule.threshold, allowance),
+            None => diff_heatmap(golden, &actual, spec.rule.threshold),
+        };
+        if let Some(heatmap) = heatmap {
             let stem = spec.file.strip_suffix(".png").unwrap_or(&spec.file);
             let diff = format!("{dir}/{stem}.diff.png");
             write_png(&out.join(&diff), &heatmap)?;
@@ -256,9 +268,14 @@ pub fn judge(rule: &Rule, metrics: &Metrics) -> (Outcome, String) {
         metrics.failing_fraction <= fraction && flip.is_none_or(|limit| metrics.flip <= limit)
     };
     let measured = format!(
-        "{} of pixels differ by more than {} codes{}",
+        "{} of pixels differ by more than {} codes{}{}",
         percent(metrics.failing_fraction),
         rule.threshold,
+        if rule.statistical {
+            " plus the golden's sampling noise"
+        } else {
+            ""
+        },
         rule.pass_flip
             .map_or(String::new(), |_| format!(", FLIP mean {:.4}", metrics.flip)),
     );
@@ -309,6 +326,7 @@ mod tests {
         pass_flip: Some(0.1),
         partial_flip: Some(0.2),
         partial_credit: 0.5,
+        statistical: false,
     };
 
     fn measured(failing_fraction: f64, flip: f64) -> Metrics {
