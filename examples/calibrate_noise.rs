@@ -2,7 +2,9 @@
 //! `cases/` with other seeds and judges each render against its golden image, as the golden
 //! suite does, to measure the false-alarm rate; then renders each planted bug (tests/noise/
 //! planted.rs) with other seeds to measure the detection rate, and prints the power the verdict
-//! states.
+//! states. For grading's `statistical = true`, it also counts the pixels of each re-seeded
+//! picture (8-bit, the case's tone map) that differ from the golden picture by more than one code
+//! plus the allowance the golden's variance gives.
 //!
 //! ```sh
 //! cargo run --release --example calibrate_noise               # 50 seeds per case, 10 per bug
@@ -19,7 +21,9 @@ use std::path::Path;
 use rayon::prelude::*;
 
 use goldray::case::{LoadOptions, load};
-use goldray::compare::Image;
+use goldray::compare::noise::png_allowance;
+use goldray::compare::{Image, PNG_DEFAULTS, Tolerance, compare_widened};
+use goldray::film::{color_image, read_exr};
 use goldray::options::Seeding;
 
 use planted::{Bug, judge, render, reseeded};
@@ -53,7 +57,15 @@ fn main() {
             .filter(|&s| s != case.render.trace.seed)
             .take(seeds as usize)
             .collect();
-        let judged: Vec<(bool, f64)> = seed_list
+        let golden_film = read_exr(&golden_path).unwrap_or_else(|e| panic!("{e}"));
+        let tonemap = case.render.tonemap;
+        let golden_picture = Image::from_rgb8(color_image(&golden_film, tonemap), "golden picture");
+        let allowance = png_allowance(&golden_film, tonemap).expect("a sampled golden carries variance");
+        let png_rule = Tolerance {
+            pixel: 1.0,
+            ..PNG_DEFAULTS
+        };
+        let judged: Vec<(bool, f64, usize)> = seed_list
             .par_iter()
             .map(|&seed| {
                 let film = render(&reseeded(&case, seed), Seeding::Seeded);
@@ -63,11 +75,16 @@ fn main() {
                     .as_ref()
                     .and_then(|n| n.strongest)
                     .map_or(0.0, |s| s.z.abs());
-                (!comparison.verdict.accepts(), z)
+                let picture = Image::from_rgb8(color_image(&film, tonemap), "picture");
+                let graded = compare_widened(&golden_picture, &picture, &png_rule, &allowance);
+                let png_failing = graded.metrics.map_or(usize::MAX, |m| m.failing_pixels);
+                (!comparison.verdict.accepts(), z, png_failing)
             })
             .collect();
-        let alarms = judged.iter().filter(|(failed, _)| *failed).count();
-        let largest = judged.iter().map(|&(_, z)| z).fold(0.0, f64::max);
+        let alarms = judged.iter().filter(|(failed, ..)| *failed).count();
+        let largest = judged.iter().map(|&(_, z, _)| z).fold(0.0, f64::max);
+        let png_worst = judged.iter().map(|&(.., failing)| failing).max().unwrap_or(0);
+        let png_total: usize = judged.iter().map(|&(.., failing)| failing).sum();
         total_alarms += alarms;
         total_runs += judged.len();
         let golden_self = judge(&case, &golden, &render(&case, Seeding::Seeded), "golden seed");
@@ -81,6 +98,12 @@ fn main() {
             100.0 * noise.alpha,
             largest,
             noise.z_critical
+        );
+        println!(
+            "  graded as 8-bit pictures (statistical = true, threshold 1 code): {png_total} pixels beyond \
+             threshold + allowance in {} pictures of {} pixels, at most {png_worst} in one",
+            judged.len(),
+            golden.pixels()
         );
         let p = &noise.power;
         let shift = |s: Option<f64>| s.map_or_else(|| "none".to_owned(), |s| format!("{s:.2e}"));

@@ -8,6 +8,10 @@
 //!   regression;
 //! - **pass** when no channel of any pixel differs by more than `pixel`.
 //!
+//! When both images carry variance (sampled renders), colour values with variance are judged by the
+//! statistical test of [`super::noise`] instead (a significant one is the `significance` breach),
+//! and `rmse` and `max` are not applied to colour.
+//!
 //! A size, encoding or channel-set mismatch is its own verdict, decided before anything is
 //! measured, because no metric means anything across it.
 
