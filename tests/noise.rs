@@ -3,7 +3,7 @@
 //!
 //! The re-seeding and planted-bug tests render the sampled cases of `cases/` at full size and
 //! judge them against the committed goldens, exactly as the golden suite does. The 50-seed
-//! false-alarm test renders the same cases at 64×64 against a golden rendered here at that size,
+//! false-alarm test renders the same cases at 48×48 against a golden rendered here at that size,
 //! to keep it quick; `examples/calibrate_noise.rs` measures the same at full size (README).
 
 #[path = "noise/planted.rs"]
@@ -120,8 +120,8 @@ fn false_alarms_over_fifty_seeds_stay_within_the_nominal_bound() {
     let report: Vec<(String, usize)> = sampled_cases()
         .par_iter()
         .map(|case| {
-            let small = resized(case, 64, 64);
-            let golden = Image::from_film(&render(&small, Seeding::Seeded), "golden at 64×64");
+            let small = resized(case, 48, 48);
+            let golden = Image::from_film(&render(&small, Seeding::Seeded), "golden at 48×48");
             let alarms = (1..=SEEDS)
                 .map(|k| reseeded(&small, 7000 + k))
                 .filter(|reseeded| {

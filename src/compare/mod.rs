@@ -24,6 +24,7 @@ mod image;
 mod metrics;
 pub mod noise;
 mod normal;
+mod power;
 mod tolerance;
 mod verdict;
 
@@ -33,6 +34,7 @@ pub use files::{FileComparison, ToleranceOverrides, compare_files};
 pub use heatmap::{FAILING, NON_FINITE, comparison_heatmap, diff_heatmap, diff_heatmap_widened, evidence_heatmap};
 pub use image::{COLOR_CHANNELS, Channel, Encoding, Image};
 pub use metrics::{ChannelStats, Metrics, NonFinite, PixelError};
-pub use noise::{Evidence, Noise, Power};
+pub use noise::{Evidence, Noise};
+pub use power::{POWER_PROBABILITY, POWER_WINDOW, Power};
 pub use tolerance::{EXR_DEFAULTS, PNG_DEFAULTS, Tolerance};
 pub use verdict::{Breach, Layout, Limit, Verdict};

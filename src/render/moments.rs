@@ -193,8 +193,9 @@ mod tests {
         for _ in 0..4 {
             total.add_weighted(&moments(&[0.0, 1.0]), 0.25);
         }
-        // Each part: variance of the mean 0.125; four of them at weight 1/4: 4 · 0.125 / 16.
+        // Each part: sample variance 1/2, variance of the mean 1/4; four of them at weight 1/4:
+        // 4 · (1/4) / 16.
         assert_eq!(total.mean.x, 0.5);
-        assert!((total.variance.x - 0.03125).abs() < 1e-7);
+        assert!((total.variance.x - 0.0625).abs() < 1e-7, "{}", total.variance.x);
     }
 }
