@@ -89,7 +89,10 @@ impl Area {
                 let reach = normal::upper_quantile(POWER_PROBABILITY / self.sigmas.len() as f64);
                 let low = sigma * (rule.z_critical - reach).max(1e-3);
                 let high = sigma * (rule.z_critical + 0.85);
-                (low.min(certain.unwrap_or(f64::INFINITY)) * 0.999, high.min(certain.unwrap_or(f64::INFINITY)))
+                (
+                    low.min(certain.unwrap_or(f64::INFINITY)) * 0.999,
+                    high.min(certain.unwrap_or(f64::INFINITY)),
+                )
             }
         };
         for _ in 0..24 {
