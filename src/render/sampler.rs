@@ -31,13 +31,13 @@ impl Sampler {
 
     /// Position of sample `index` inside pixel `(x, y)`, in `[0, 1)²`: a uniformly jittered point
     /// in stratum `(index mod n, index div n)`.
+    #[inline]
     pub fn offset(&self, x: u32, y: u32, index: u32) -> Vec2 {
         if self.strata == 1 {
             return Vec2::splat(0.5);
         }
         if self.seeding == Seeding::PixelIndex {
-            let hash = mix(mix(0x9e37_79b9_7f4a_7c15, x as u64), y as u64);
-            return Vec2::new(unit_interval(hash), unit_interval(mix(hash, 0x5bd1_e995)));
+            return pixel_seeded(x, y);
         }
         let n = self.strata as Real;
         let hash = mix(mix(mix(self.seed ^ 0x9e37_79b9_7f4a_7c15, x as u64), y as u64), index as u64);
@@ -45,6 +45,14 @@ impl Sampler {
         let jitter = Vec2::new(unit_interval(hash), unit_interval(mix(hash, 0x5bd1_e995)));
         (stratum + jitter) / n
     }
+}
+
+/// [`Seeding::PixelIndex`]'s one point per pixel, out of line so that the seeded path stays as
+/// small as it was.
+#[cold]
+fn pixel_seeded(x: u32, y: u32) -> Vec2 {
+    let hash = mix(mix(0x9e37_79b9_7f4a_7c15, x as u64), y as u64);
+    Vec2::new(unit_interval(hash), unit_interval(mix(hash, 0x5bd1_e995)))
 }
 
 /// One round of a 64-bit finaliser (Stafford's variant 13 of MurmurHash3's `fmix64`, as used by
