@@ -29,7 +29,7 @@ use goldray::geometry::aabb::Aabb;
 use goldray::geometry::bvh::Bvh;
 use goldray::geometry::generate::{blob, write_obj};
 use goldray::geometry::mesh::{Mesh, VertexNormals};
-use goldray::options::{Filter, Profile, RenderOptions, Spawn, Trace};
+use goldray::options::{Filter, Profile, RenderOptions, Seeding, Spawn, Trace};
 use goldray::pipeline::{render_case, render_options};
 use goldray::progress::Silent;
 use goldray::real::{Color, Real, Vec3};
@@ -91,6 +91,7 @@ fn primary_rays(c: &mut Criterion) {
             filter: Filter::None,
         },
         spawn: Spawn::ErrorBounds,
+        seeding: Seeding::Seeded,
         aovs: true,
     };
     let mut group = c.benchmark_group("primary_rays");
@@ -307,6 +308,7 @@ fn only_what_is_required(c: &mut Criterion) {
             filter: Filter::None,
         },
         spawn: Spawn::ErrorBounds,
+        seeding: Seeding::Seeded,
         aovs,
     };
     let renders = [

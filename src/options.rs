@@ -65,6 +65,20 @@ impl Spawn {
     pub const COURSE_MIRROR_THRESHOLD: f64 = 0.1;
 }
 
+/// Where the jitter's random numbers come from.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub enum Seeding {
+    /// A hash of (seed, pixel, sample index): what every case renders with.
+    #[default]
+    Seeded,
+    /// A hash of the pixel alone, the same for every sample and every seed: a program that calls
+    /// `srand(pixel index)` before drawing each sample's position with `rand()`. Every sample of
+    /// a pixel lands on one random point, so the picture is as aliased as one sample per pixel.
+    /// A case file cannot choose it; it is offered to library users to measure what the
+    /// statistical verdict detects (examples/calibrate_noise.rs, tests/noise.rs).
+    PixelIndex,
+}
+
 /// What a render traces: the part a case's `[render]` table and the renderer's options share,
 /// defined once so that the two cannot drift apart.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -85,6 +99,7 @@ pub struct Trace {
 pub struct RenderOptions {
     pub trace: Trace,
     pub spawn: Spawn,
+    pub seeding: Seeding,
     /// Whether anything reads the depth and normal AOVs. Without them no ray is traced for
     /// them and the film's `depth` and `normal` stay as [`crate::film::Film::new`] made them:
     /// all misses.

@@ -10,7 +10,7 @@ use crate::case::{
 };
 use crate::error::Error;
 use crate::film::{Film, OutputOptions, write_outputs};
-use crate::options::{Profile, RenderOptions, Spawn};
+use crate::options::{Profile, RenderOptions, Seeding, Spawn};
 use crate::progress::{Progress, Silent};
 use crate::provenance::{ContentHash, Provenance, ProvenanceError, keys};
 use crate::stats::{BuildStats, Phases, RayCounts, RenderStats};
@@ -88,6 +88,7 @@ pub fn render_options(case: &Case) -> RenderOptions {
             Profile::Native => Spawn::ErrorBounds,
             Profile::Mit6837 => Spawn::Course,
         },
+        seeding: Seeding::Seeded,
         aovs: true,
     }
 }

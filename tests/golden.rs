@@ -218,7 +218,8 @@ fn is_ci() -> bool {
 }
 
 /// A failure says how the golden and the render were made differently, before the verdict: here
-/// a golden of `jitter` with seed 7 against a render with seed 8 (the case file unchanged).
+/// a golden of `jitter` with seed 7 and 16 samples against a render with seed 8 and one sample
+/// (the case file unchanged). Another seed alone passes: sampled renders are judged by their noise.
 #[test]
 fn a_failure_names_how_the_golden_and_the_render_were_made_differently() {
     let mut case = load(&cases_dir().join("jitter.toml"), &LoadOptions::default()).expect("loads");
@@ -231,6 +232,7 @@ fn a_failure_names_how_the_golden_and_the_render_were_made_differently() {
     };
     let golden = stamped(&case);
     case.render.trace.seed = 8;
+    case.render.trace.samples = 1;
     let render = stamped(&case);
     // Its pictures go to a folder of its own, not beside the suite's.
     let pictures = tempfile::tempdir().expect("tempdir");
@@ -243,11 +245,11 @@ fn a_failure_names_how_the_golden_and_the_render_were_made_differently() {
     let judged = comparator.judge_bytes(Some(&golden), Some(&render));
     assert!(
         matches!(&judged, Judged::Compared(c, _) if !c.verdict.accepts()),
-        "seed 8 fails seed 7's golden"
+        "one sample fails a 16-sample golden"
     );
     let message = failure_message(&case, Path::new("golden/jitter.snap"), Some(judged));
     assert!(
-        message.contains("made differently: golden: seed 7, 16 spp; this render: seed 8, 16 spp\n  FAIL"),
+        message.contains("made differently: golden: seed 7, 16 spp; this render: seed 8, 1 spp\n  FAIL"),
         "{message}"
     );
 
@@ -256,7 +258,7 @@ fn a_failure_names_how_the_golden_and_the_render_were_made_differently() {
     let judged = comparator.judge_bytes(Some(&unstamped), Some(&render));
     let message = failure_message(&case, Path::new("golden/jitter.snap"), Some(judged));
     assert!(
-        message.contains("made differently: golden: no provenance; this render: jitter.toml, 128x128, seed 8, 16 spp"),
+        message.contains("made differently: golden: no provenance; this render: jitter.toml, 128x128, seed 8, 1 spp"),
         "{message}"
     );
 }

@@ -7,7 +7,8 @@ use std::time::Duration;
 use serde::Serialize;
 
 use super::image::{COLOR_CHANNELS, Encoding, Image};
-use super::metrics::{Metrics, measure, same_layout};
+use super::metrics::{ColourRule, Metrics, measure, same_layout};
+use super::noise::{self, Noise};
 use super::tolerance::Tolerance;
 use super::verdict::{Layout, Verdict, judge, percent};
 
@@ -19,22 +20,38 @@ pub struct Comparison {
     pub actual: PathBuf,
     pub tolerance: Tolerance,
     pub metrics: Option<Metrics>,
+    /// The statistical test, when both images carry the variance of their mean colour.
+    pub noise: Option<Noise>,
     pub verdict: Verdict,
     /// Where the caller wrote the diff heatmap, for the report to point at.
     pub diff_image: Option<PathBuf>,
 }
 
-/// Compares `actual` against `expected` under `tolerance`, in the images' own units.
+/// Compares `actual` against `expected` under `tolerance`, in the images' own units. When both
+/// are EXRs with variance channels (sampled renders), colour values with variance are judged by
+/// the statistical test of [`noise`](super::noise) and the rest by `tolerance`.
 ///
 /// A NaN limit counts as 0, the strictest: every comparison with NaN is false, so taken as given
 /// it would let any difference through.
 pub fn compare(expected: &Image, actual: &Image, tolerance: &Tolerance) -> Comparison {
-    compare_timed(expected, actual, tolerance).0
+    compare_timed(expected, actual, tolerance, None).0
 }
 
-/// [`compare`], and how long its FLIP measurement took (zero when nothing was measured), for
-/// callers that report where their time goes.
-pub fn compare_timed(expected: &Image, actual: &Image, tolerance: &Tolerance) -> (Comparison, Duration) {
+/// [`compare`] of two images without variance (a student's 8-bit picture against the golden's),
+/// each colour value's `pixel` threshold widened by its `allowance` (see
+/// [`noise::png_allowance`]): the statistical verdict where only the golden knows its noise.
+pub fn compare_widened(expected: &Image, actual: &Image, tolerance: &Tolerance, allowance: &[[f32; 3]]) -> Comparison {
+    compare_timed(expected, actual, tolerance, Some(allowance)).0
+}
+
+/// [`compare`], or [`compare_widened`] with an `allowance`, and how long its FLIP measurement took
+/// (zero when nothing was measured), for callers that report where their time goes.
+pub fn compare_timed(
+    expected: &Image,
+    actual: &Image,
+    tolerance: &Tolerance,
+    allowance: Option<&[[f32; 3]]>,
+) -> (Comparison, Duration) {
     let strict = |limit: f64| if limit.is_nan() { 0.0 } else { limit };
     let tolerance = &Tolerance {
         pixel: strict(tolerance.pixel),
@@ -42,22 +59,31 @@ pub fn compare_timed(expected: &Image, actual: &Image, tolerance: &Tolerance) ->
         rmse: strict(tolerance.rmse),
         max: tolerance.max.map(strict),
     };
-    let (metrics, verdict, flip) = if same_layout(expected, actual) {
-        let (metrics, flip) = measure(expected, actual, tolerance.pixel);
-        let verdict = judge(&metrics, tolerance);
-        (Some(metrics), verdict, flip)
+    let widened = allowance.filter(|a| a.len() == expected.pixels());
+    let (metrics, noise, verdict, flip) = if same_layout(expected, actual) {
+        let sigmas = noise::sigmas(expected, actual).filter(|_| widened.is_none());
+        let colour = match (&sigmas, widened) {
+            (_, Some(allowance)) => ColourRule::Widened(allowance),
+            (Some(sigmas), None) => ColourRule::Tested(sigmas),
+            (None, None) => ColourRule::Threshold,
+        };
+        let (metrics, flip) = measure(expected, actual, tolerance.pixel, colour);
+        let noise = sigmas.map(|sigmas| noise::test(expected, actual, &sigmas, tolerance));
+        let verdict = judge(&metrics, tolerance, noise.as_ref());
+        (Some(metrics), noise, verdict, flip)
     } else {
         let verdict = Verdict::Mismatch {
             expected: Layout::of(expected),
             actual: Layout::of(actual),
         };
-        (None, verdict, Duration::ZERO)
+        (None, None, verdict, Duration::ZERO)
     };
     let comparison = Comparison {
         expected: expected.source.clone(),
         actual: actual.source.clone(),
         tolerance: tolerance.clone(),
         metrics,
+        noise,
         verdict,
         diff_image: None,
     };
@@ -81,6 +107,7 @@ struct JsonReport<'a> {
     actual: &'a PathBuf,
     tolerance: JsonTolerance,
     metrics: &'a Option<Metrics>,
+    noise: &'a Option<Noise>,
     diff_image: &'a Option<PathBuf>,
 }
 
@@ -101,6 +128,7 @@ impl Comparison {
                 max: t.max,
             },
             metrics: &self.metrics,
+            noise: &self.noise,
             diff_image: &self.diff_image,
         };
         serde_json::to_string_pretty(&report)
@@ -128,28 +156,67 @@ impl fmt::Display for Comparison {
             }
             Verdict::Pass | Verdict::Warn => {}
         }
+        if let Some(noise) = &self.noise {
+            write_noise(f, noise)?;
+        }
         if let Some(metrics) = &self.metrics {
-            write_metrics(f, metrics)?;
+            write_metrics(f, metrics, self.noise.is_some())?;
         }
         if let Some(path) = &self.diff_image {
-            writeln!(
-                f,
-                "  diff heatmap: {} (magenta = failing pixel, cyan = NaN/inf)",
-                path.display()
-            )?;
+            let legend = if self.noise.is_some() {
+                "|z| from 1 (dark red) to the threshold (yellow); magenta = significant or failing, cyan = NaN/inf"
+            } else {
+                "magenta = failing pixel, cyan = NaN/inf"
+            };
+            writeln!(f, "  diff heatmap: {} ({legend})", path.display())?;
         }
         Ok(())
     }
 }
 
-fn write_metrics(f: &mut fmt::Formatter<'_>, m: &Metrics) -> fmt::Result {
+/// The statistical test's lines: what was tested, what it found, and what it could have found.
+fn write_noise(f: &mut fmt::Formatter<'_>, noise: &Noise) -> fmt::Result {
+    writeln!(
+        f,
+        "  statistical test: {} colour values with variance, Šidák-corrected Z test at α = {} \
+         (|z| over {:.2}); {} significant",
+        noise.tests, noise.alpha, noise.z_critical, noise.significant
+    )?;
+    if let Some(strongest) = &noise.strongest {
+        writeln!(
+            f,
+            "  strongest evidence: z = {:.2} at {} (σ {:.3e})",
+            strongest.z, strongest.at, strongest.sigma
+        )?;
+    }
+    let p = &noise.power;
+    let shift = |s: Option<f64>| s.map_or_else(|| "none".to_owned(), |s| format!("{s:.2e}"));
+    writeln!(
+        f,
+        "  power: detects with {:.0}% probability a shift of {} on every colour value, or of {} over a {}×{} \
+         area ({} where it sees least)",
+        p.probability * 100.0,
+        shift(p.uniform_shift),
+        shift(p.local_shift_median),
+        p.window,
+        p.window,
+        shift(p.local_shift_worst),
+    )
+}
+
+fn write_metrics(f: &mut fmt::Formatter<'_>, m: &Metrics, statistical: bool) -> fmt::Result {
     let units = match m.encoding {
         Encoding::Linear => "linear",
         Encoding::Code8 => "8-bit codes",
     };
+    let which = if statistical {
+        " (depth, normals and colour values without variance)"
+    } else {
+        ""
+    };
     writeln!(
         f,
-        "  failing pixels: {} of {} ({}) differ by more than {} ({units})",
+        "  failing pixels{which}: {} of {} ({}) differ by more than {} ({units})",
         m.failing_pixels,
         m.pixels,
         percent(m.failing_fraction),

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use super::comparison::{Comparison, compare};
 use super::error::CompareError;
-use super::heatmap::diff_heatmap;
+use super::heatmap::comparison_heatmap;
 use super::image::{Encoding, Image};
 use super::tolerance::{EXR_DEFAULTS, PNG_DEFAULTS, Tolerance};
 use crate::film::write_png;
@@ -66,11 +66,12 @@ pub fn compare_files(
 }
 
 impl FileComparison {
-    /// Writes the heatmap of the differences to `path` and records it in the comparison.
+    /// Writes the heatmap of the differences (of the evidence, for a statistical comparison) to
+    /// `path` and records it in the comparison.
     /// Returns `Ok(false)`, writing nothing, when the images cannot be laid over each other
     /// (different sizes or channels).
     pub fn write_heatmap(&mut self, path: &Path) -> Result<bool, CompareError> {
-        let Some(heatmap) = diff_heatmap(&self.expected, &self.actual, self.tolerance.pixel) else {
+        let Some(heatmap) = comparison_heatmap(&self.expected, &self.actual, &self.comparison) else {
             return Ok(false);
         };
         write_png(path, &heatmap).map_err(|source| CompareError::WriteDiff {

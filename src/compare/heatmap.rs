@@ -7,11 +7,17 @@
 //! yellow). A pixel beyond the threshold (or whose depth changed between hit and miss) is solid
 //! magenta, and one holding NaN or infinity in only one image is solid cyan: neither colour
 //! occurs on the red–yellow scale.
+//!
+//! A statistical comparison (both images carry variance) draws the evidence instead
+//! ([`evidence_heatmap`]): each pixel's largest |z| on the same red–yellow scale, linear from
+//! |z| = 1 (what noise gives most of the time) to the Šidák threshold, magenta beyond it.
 
 use image::{Rgb, RgbImage};
 
-use super::image::Image;
-use super::metrics::{Difference, difference};
+use super::comparison::Comparison;
+use super::image::{COLOR_CHANNELS, Image};
+use super::metrics::{ColourRule, Difference, difference};
+use super::noise::{self, Noise};
 
 pub const FAILING: [u8; 3] = [255, 0, 255];
 pub const NON_FINITE: [u8; 3] = [0, 255, 255];
@@ -23,6 +29,24 @@ const BACKDROP: f32 = 0.3;
 
 /// `None` when the images cannot be laid over each other (different sizes or channels).
 pub fn diff_heatmap(expected: &Image, actual: &Image, pixel_threshold: f64) -> Option<RgbImage> {
+    heatmap_with(expected, actual, pixel_threshold, ColourRule::Threshold)
+}
+
+/// [`diff_heatmap`] of a [`super::compare_widened`] comparison: a colour value is magenta when it
+/// differs by more than the threshold plus its allowance.
+pub fn diff_heatmap_widened(
+    expected: &Image,
+    actual: &Image,
+    pixel_threshold: f64,
+    allowance: &[[f32; 3]],
+) -> Option<RgbImage> {
+    if allowance.len() != expected.pixels() {
+        return None;
+    }
+    heatmap_with(expected, actual, pixel_threshold, ColourRule::Widened(allowance))
+}
+
+fn heatmap_with(expected: &Image, actual: &Image, pixel_threshold: f64, colour: ColourRule) -> Option<RgbImage> {
     if !super::metrics::same_layout(expected, actual) {
         return None;
     }
@@ -32,10 +56,14 @@ pub fn diff_heatmap(expected: &Image, actual: &Image, pixel_threshold: f64) -> O
         let mut largest = 0.0_f64;
         let mut failing = false;
         for (e, a) in expected.channels.iter().zip(&actual.channels) {
+            let colour_index = COLOR_CHANNELS.iter().position(|&c| c == e.name);
             match difference(e.values[i], a.values[i], e.infinity_is_a_value()) {
                 Difference::Broken => return Rgb(NON_FINITE),
                 diff @ (Difference::Finite(_) | Difference::Coverage) => {
-                    failing |= diff.exceeds(pixel_threshold);
+                    failing |= match colour_index {
+                        Some(c) => colour.fails(diff, pixel_threshold, i, c),
+                        None => diff.exceeds(pixel_threshold),
+                    };
                     if let Difference::Finite(d) = diff {
                         largest = largest.max(d);
                     }
@@ -45,14 +73,71 @@ pub fn diff_heatmap(expected: &Image, actual: &Image, pixel_threshold: f64) -> O
         if failing {
             return Rgb(FAILING);
         }
-        let [r, g, b] = expected.preview.get_pixel(x, y).0.map(f32::from);
-        let grey = (0.2126 * r + 0.7152 * g + 0.0722 * b) * BACKDROP;
         if largest == 0.0 {
-            return Rgb([grey as u8; 3]);
+            return backdrop(expected, x, y);
         }
         let t = ((largest / pixel_threshold).log10() / DECADES + 1.0).clamp(0.0, 1.0) as f32;
-        let hot = [255.0, 40.0 + 215.0 * t, 0.0];
-        let weight = 0.4 + 0.6 * t;
-        Rgb(hot.map(|h| (grey + (h - grey) * weight).round() as u8))
+        hot(expected, x, y, t)
     }))
+}
+
+/// The heatmap that fits `comparison`: the evidence of a statistical one, the differences of any
+/// other. `None` when the images cannot be laid over each other.
+pub fn comparison_heatmap(expected: &Image, actual: &Image, comparison: &Comparison) -> Option<RgbImage> {
+    match &comparison.noise {
+        Some(noise) => evidence_heatmap(expected, actual, noise, comparison.tolerance.pixel),
+        None => diff_heatmap(expected, actual, comparison.tolerance.pixel),
+    }
+}
+
+/// Where a statistical comparison's evidence lies: each pixel's largest |z| over its tested colour
+/// values, from 1 (dark red) to `noise.z_critical` (yellow); magenta for a pixel over the
+/// threshold or failing the `pixel` rule in a channel judged by it (depth, normals, colour
+/// without variance); cyan for NaN/infinity in one image only. Pixels at |z| ≤ 1 show the
+/// backdrop. `None` when the images cannot be laid over each other or carry no variance.
+pub fn evidence_heatmap(expected: &Image, actual: &Image, noise: &Noise, pixel_threshold: f64) -> Option<RgbImage> {
+    if !super::metrics::same_layout(expected, actual) {
+        return None;
+    }
+    let sigmas = noise::sigmas(expected, actual)?;
+    let z = noise::z_scores(expected, actual, &sigmas);
+    let width = expected.width as usize;
+    Some(RgbImage::from_fn(expected.width, expected.height, |x, y| {
+        let i = y as usize * width + x as usize;
+        let mut failing = false;
+        for (e, a) in expected.channels.iter().zip(&actual.channels) {
+            let colour = ["R", "G", "B"].iter().position(|&c| c == e.name);
+            match difference(e.values[i], a.values[i], e.infinity_is_a_value()) {
+                Difference::Broken => return Rgb(NON_FINITE),
+                diff => failing |= diff.exceeds(pixel_threshold) && colour.is_none_or(|c| sigmas[i][c].is_none()),
+            }
+        }
+        let largest = z[i].iter().flatten().fold(0.0_f64, |m, z| m.max(z.abs()));
+        if failing || largest > noise.z_critical {
+            return Rgb(FAILING);
+        }
+        if largest <= 1.0 {
+            return backdrop(expected, x, y);
+        }
+        let t = ((largest - 1.0) / (noise.z_critical - 1.0)).clamp(0.0, 1.0) as f32;
+        hot(expected, x, y, t)
+    }))
+}
+
+/// The expected image as dim grey.
+fn backdrop(expected: &Image, x: u32, y: u32) -> Rgb<u8> {
+    Rgb([grey(expected, x, y) as u8; 3])
+}
+
+fn grey(expected: &Image, x: u32, y: u32) -> f32 {
+    let [r, g, b] = expected.preview.get_pixel(x, y).0.map(f32::from);
+    (0.2126 * r + 0.7152 * g + 0.0722 * b) * BACKDROP
+}
+
+/// The red–yellow scale at `t` in [0, 1], over the backdrop.
+fn hot(expected: &Image, x: u32, y: u32, t: f32) -> Rgb<u8> {
+    let grey = grey(expected, x, y);
+    let hot = [255.0, 40.0 + 215.0 * t, 0.0];
+    let weight = 0.4 + 0.6 * t;
+    Rgb(hot.map(|h| (grey + (h - grey) * weight).round() as u8))
 }

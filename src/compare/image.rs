@@ -62,6 +62,9 @@ pub struct Image {
     pub width: u32,
     pub height: u32,
     pub channels: Vec<Channel>,
+    /// The variance of each pixel's mean colour (R, G, B), when the image is an EXR of a render
+    /// with several samples per pixel: what the statistical verdict weighs differences by.
+    pub variance: Option<Vec<[f32; 3]>>,
     /// The colour as a person sees it: FLIP's input and the heatmap's backdrop.
     pub preview: RgbImage,
 }
@@ -86,6 +89,7 @@ impl Image {
                 .enumerate()
                 .map(|(c, &name)| Channel { name, values: plane(c) })
                 .collect(),
+            variance: None,
             preview: picture,
         }
     }
@@ -169,6 +173,7 @@ impl Image {
             width: film.width,
             height: film.height,
             channels,
+            variance: film.variance.clone(),
             preview: color_image(film, Tonemap::Srgb),
         }
     }

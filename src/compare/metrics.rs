@@ -147,9 +147,38 @@ pub struct Metrics {
     pub non_finite: Option<NonFinite>,
 }
 
-/// Both images must have the same size and channel list (`compare` checks that first). Also
-/// returns how long FLIP took, which is most of a comparison's cost.
-pub(super) fn measure(expected: &Image, actual: &Image, pixel_threshold: f64) -> (Metrics, Duration) {
+/// How a colour value is held to the pixel threshold.
+#[derive(Clone, Copy)]
+pub(super) enum ColourRule<'a> {
+    /// Every value, as any other channel.
+    Threshold,
+    /// A value with a σ (the statistical verdict's) is left to the statistical test: it is
+    /// measured (MAE, RMSE, worst) but never counts as failing.
+    Tested(&'a [[Option<f64>; 3]]),
+    /// Each value's threshold is widened by its allowance (a golden's noise, in the images' units).
+    Widened(&'a [[f32; 3]]),
+}
+
+impl ColourRule<'_> {
+    /// Whether colour channel `c` of pixel `i` fails with `diff` under `threshold`.
+    pub(super) fn fails(self, diff: Difference, threshold: f64, i: usize, c: usize) -> bool {
+        match self {
+            ColourRule::Threshold => diff.exceeds(threshold),
+            ColourRule::Tested(tested) => tested[i][c].is_none() && diff.exceeds(threshold),
+            ColourRule::Widened(allowance) => diff.exceeds(threshold + f64::from(allowance[i][c])),
+        }
+    }
+}
+
+/// Both images must have the same size and channel list (`compare` checks that first); colour
+/// values are held to the threshold as `colour` says. Also returns how long FLIP took, which is
+/// most of a comparison's cost.
+pub(super) fn measure(
+    expected: &Image,
+    actual: &Image,
+    pixel_threshold: f64,
+    colour: ColourRule,
+) -> (Metrics, Duration) {
     let width = expected.width as usize;
     let pixels = expected.pixels();
     let mut failing = vec![false; pixels];
@@ -158,7 +187,8 @@ pub(super) fn measure(expected: &Image, actual: &Image, pixel_threshold: f64) ->
     let (mut sum_abs, mut sum_sq) = (0.0_f64, 0.0_f64);
 
     for (e, a) in expected.channels.iter().zip(&actual.channels) {
-        let is_color = COLOR_CHANNELS.contains(&e.name);
+        let color_index = COLOR_CHANNELS.iter().position(|&c| c == e.name);
+        let is_color = color_index.is_some();
         let mut stats = ChannelStats {
             name: e.name,
             failing: 0,
@@ -174,7 +204,11 @@ pub(super) fn measure(expected: &Image, actual: &Image, pixel_threshold: f64) ->
                 actual: av,
             };
             let diff = difference(ev, av, e.infinity_is_a_value());
-            if diff.exceeds(pixel_threshold) {
+            let fails = match color_index {
+                Some(c) => colour.fails(diff, pixel_threshold, i, c),
+                None => diff.exceeds(pixel_threshold),
+            };
+            if fails {
                 stats.failing += 1;
                 failing[i] = true;
             }

@@ -8,6 +8,10 @@
 //!   regression;
 //! - **pass** when no channel of any pixel differs by more than `pixel`.
 //!
+//! When both images carry variance (sampled renders), colour values with variance are judged by the
+//! statistical test of [`super::noise`] instead (a significant one is the `significance` breach),
+//! and `rmse` and `max` are not applied to colour.
+//!
 //! A size, encoding or channel-set mismatch is its own verdict, decided before anything is
 //! measured, because no metric means anything across it.
 
@@ -15,8 +19,10 @@ use std::fmt;
 
 use serde::Serialize;
 
+use super::image::COLOR_CHANNELS;
 use super::image::{Encoding, Image};
-use super::metrics::{Metrics, PixelError, largest};
+use super::metrics::{ChannelStats, Metrics, PixelError, largest};
+use super::noise::Noise;
 use super::tolerance::Tolerance;
 
 /// The limit of a [`Tolerance`] that a comparison broke.
@@ -27,6 +33,8 @@ pub enum Limit {
     FailFraction,
     Rmse,
     Max,
+    /// The statistical test: a colour value differs by more than noise explains.
+    Significance,
 }
 
 impl Limit {
@@ -37,6 +45,7 @@ impl Limit {
             Limit::FailFraction => "fail_fraction",
             Limit::Rmse => "rmse",
             Limit::Max => "max",
+            Limit::Significance => "significance",
         }
     }
 }
@@ -106,7 +115,10 @@ impl Verdict {
     }
 }
 
-pub(super) fn judge(metrics: &Metrics, tolerance: &Tolerance) -> Verdict {
+/// With `noise` (both images carry variance), colour values with variance are judged by the
+/// statistical test instead of `pixel`, and `rmse` and `max` are not applied to colour: on a noisy
+/// picture they measure the noise, which is what the test weighs.
+pub(super) fn judge(metrics: &Metrics, tolerance: &Tolerance, noise: Option<&Noise>) -> Verdict {
     let mut breaches = Vec::new();
     if let Some(non_finite) = &metrics.non_finite {
         breaches.push(Breach {
@@ -124,7 +136,18 @@ pub(super) fn judge(metrics: &Metrics, tolerance: &Tolerance) -> Verdict {
             at: None,
         });
     }
-    if metrics.rmse > tolerance.rmse {
+    if let Some(noise) = noise
+        && noise.significant > 0
+        && let Some(strongest) = &noise.strongest
+    {
+        breaches.push(Breach {
+            limit: Limit::Significance,
+            measured: strongest.z.abs(),
+            allowed: noise.z_critical,
+            at: Some(strongest.at),
+        });
+    }
+    if noise.is_none() && metrics.rmse > tolerance.rmse {
         breaches.push(Breach {
             limit: Limit::Rmse,
             measured: metrics.rmse,
@@ -133,7 +156,8 @@ pub(super) fn judge(metrics: &Metrics, tolerance: &Tolerance) -> Verdict {
         });
     }
     if let Some(max) = tolerance.max {
-        let worst = largest(metrics.channels.iter().filter_map(|c| c.worst));
+        let judged = |c: &&ChannelStats| noise.is_none() || !COLOR_CHANNELS.contains(&c.name);
+        let worst = largest(metrics.channels.iter().filter(judged).filter_map(|c| c.worst));
         if let Some(worst) = worst.filter(|w| w.error() > max) {
             breaches.push(Breach {
                 limit: Limit::Max,
@@ -176,6 +200,12 @@ impl fmt::Display for Breach {
                 f,
                 "max: a channel differs by {measured:.6}, over the {allowed} allowed ({})",
                 times(measured, allowed)
+            )?,
+            Limit::Significance => write!(
+                f,
+                "significance: a colour differs by {measured:.2} σ, over the {allowed:.2} σ that noise \
+                 reaches (Šidák, α = {} family-wise)",
+                super::noise::FAMILY_ALPHA
             )?,
         }
         match (&self.at, self.limit) {

@@ -31,7 +31,7 @@ pub enum OutputError {
 
     #[error(
         "refusing to write {file}: the film is {width}x{height} but holds {colors} colours, \
-         {depths} depths and {normals} normals"
+         {depths} depths, {normals} normals and {variances} variances"
     )]
     FilmShape {
         file: String,
@@ -40,6 +40,7 @@ pub enum OutputError {
         colors: usize,
         depths: usize,
         normals: usize,
+        variances: usize,
     },
 
     #[error("cannot encode {file}: {source}")]

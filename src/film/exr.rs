@@ -28,6 +28,11 @@ const MAX_DECODE_BYTES: usize = 1 << 30;
 /// first non-finite value of a pixel is reported.
 const CHANNELS: [&str; 7] = ["R", "G", "B", "Z", "N.X", "N.Y", "N.Z"];
 
+/// The variance of each pixel's mean colour, written only for a render with several samples per
+/// pixel (`Film::variance`). A layer `var` in OpenEXR's naming, so tev and Blender show it as
+/// its own image beside the colour.
+pub const VARIANCE_CHANNELS: [&str; 3] = ["var.R", "var.G", "var.B"];
+
 /// Encodes the film as a one-part, ZIP-compressed, increasing-line-order f32 scanline EXR.
 ///
 /// Compression runs on the calling thread: the exr crate's parallel writer builds a fresh thread
@@ -63,19 +68,21 @@ pub fn write_exr(path: &Path, film: &Film) -> Result<(), OutputError> {
 pub(super) fn encode_exr_named(film: &Film, file: &str) -> Result<Vec<u8>, OutputError> {
     check_film(film, file)?;
     let channel = |name: &str, values: Vec<f32>| AnyChannel::new(name, FlatSamples::F32(values));
-    let channels = AnyChannels::sort(
-        [
-            channel("R", film.color.iter().map(|c| c[0]).collect()),
-            channel("G", film.color.iter().map(|c| c[1]).collect()),
-            channel("B", film.color.iter().map(|c| c[2]).collect()),
-            channel("Z", film.depth.clone()),
-            channel("N.X", film.normal.iter().map(|n| n[0]).collect()),
-            channel("N.Y", film.normal.iter().map(|n| n[1]).collect()),
-            channel("N.Z", film.normal.iter().map(|n| n[2]).collect()),
-        ]
-        .into_iter()
-        .collect(),
-    );
+    let mut list = vec![
+        channel("R", film.color.iter().map(|c| c[0]).collect()),
+        channel("G", film.color.iter().map(|c| c[1]).collect()),
+        channel("B", film.color.iter().map(|c| c[2]).collect()),
+        channel("Z", film.depth.clone()),
+        channel("N.X", film.normal.iter().map(|n| n[0]).collect()),
+        channel("N.Y", film.normal.iter().map(|n| n[1]).collect()),
+        channel("N.Z", film.normal.iter().map(|n| n[2]).collect()),
+    ];
+    if let Some(variance) = &film.variance {
+        for (c, name) in VARIANCE_CHANNELS.into_iter().enumerate() {
+            list.push(channel(name, variance.iter().map(|v| v[c]).collect()));
+        }
+    }
+    let channels = AnyChannels::sort(list.into_iter().collect());
     let encoding = Encoding {
         compression: Compression::ZIP16,
         blocks: Blocks::ScanLines,
@@ -99,7 +106,11 @@ pub(super) fn encode_exr_named(film: &Film, file: &str) -> Result<Vec<u8>, Outpu
 /// can use. Depth alone may be `+inf`: that is how a miss is stored.
 fn check_film(film: &Film, file: &str) -> Result<(), OutputError> {
     let pixels = film.width as usize * film.height as usize;
-    if film.width == 0 || film.height == 0 || [film.color.len(), film.depth.len(), film.normal.len()] != [pixels; 3] {
+    let variances = film.variance.as_ref().map_or(pixels, Vec::len);
+    if film.width == 0
+        || film.height == 0
+        || [film.color.len(), film.depth.len(), film.normal.len(), variances] != [pixels; 4]
+    {
         return Err(OutputError::FilmShape {
             file: file.to_owned(),
             width: film.width,
@@ -107,6 +118,7 @@ fn check_film(film: &Film, file: &str) -> Result<(), OutputError> {
             colors: film.color.len(),
             depths: film.depth.len(),
             normals: film.normal.len(),
+            variances,
         });
     }
     let pixel_values = film.color.iter().zip(&film.depth).zip(&film.normal);
@@ -128,6 +140,24 @@ fn check_film(film: &Film, file: &str) -> Result<(), OutputError> {
                 value,
             });
         }
+    }
+    let variances = film.variance.iter().flatten().enumerate();
+    let bad = variances.flat_map(|(i, v)| {
+        v.iter()
+            .zip(VARIANCE_CHANNELS)
+            .map(move |(&value, channel)| (i, value, channel))
+    });
+    if let Some((i, value, channel)) = bad
+        .into_iter()
+        .find(|&(_, value, _)| !(value.is_finite() && value >= 0.0))
+    {
+        return Err(OutputError::NonFinite {
+            file: file.to_owned(),
+            x: (i % film.width as usize) as u32,
+            y: (i / film.width as usize) as u32,
+            channel,
+            value,
+        });
     }
     Ok(())
 }
@@ -206,6 +236,10 @@ fn decode_exr_named(bytes: &[u8], file: &str) -> Result<Film, OutputError> {
                 normal[axis] = value;
             }
         }
+    }
+    let [vr, vg, vb] = VARIANCE_CHANNELS.map(channel);
+    if let (Some(r), Some(g), Some(b)) = (vr?, vg?, vb?) {
+        film.variance = Some((0..width * height).map(|i| [r[i], g[i], b[i]]).collect());
     }
     Ok(film)
 }

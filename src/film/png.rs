@@ -114,6 +114,17 @@ fn quantise(v: f32, tonemap: Tonemap) -> u8 {
     }
 }
 
+/// The tone map before its rounding rule: the 8-bit code a linear value maps to, as a real
+/// number (0 to 255). What a statistical comparison of PNGs converts a linear noise level with.
+pub fn tone_curve(linear: f32, tonemap: Tonemap) -> f32 {
+    let v = if linear.is_nan() { 0.0 } else { linear.clamp(0.0, 1.0) };
+    255.0
+        * match tonemap {
+            Tonemap::Srgb => srgb_encode(v),
+            Tonemap::Clamp => v,
+        }
+}
+
 /// The piecewise sRGB transfer curve of IEC 61966-2-1 (not a pure 2.2 gamma, which would darken
 /// the shadows by several codes).
 fn srgb_encode(linear: f32) -> f32 {

@@ -17,7 +17,7 @@ use super::golden::{CacheMode, default_cache_dir, prepare_goldens, write_golden_
 use super::report::{self, ClassReport, RubricSummary};
 use super::resume::{StudentRecord, read_record, run_fingerprint, student_fingerprint, write_record};
 use super::rubric::load_rubric;
-use super::score::{StudentResult, Submission, grade_image};
+use super::score::{Golden, StudentResult, Submission, grade_image};
 use super::shard::{Manifest, Shard, copy_pictures, read_shards, write_manifest};
 use super::similarity::{self, similar_pairs};
 use super::timing::{RunCost, Timings, timed};
@@ -88,12 +88,16 @@ pub fn grade(
                     .images
                     .par_iter()
                     .zip(&goldens.images)
-                    .map(|(spec, golden)| {
+                    .zip(&goldens.allowances)
+                    .map(|((spec, golden), allowance)| {
                         let mut timings = Timings::default();
                         let published = published.get(&spec.file).copied();
                         grade_image(
                             spec,
-                            golden,
+                            Golden {
+                                picture: golden,
+                                allowance: allowance.as_deref().map(Vec::as_slice),
+                            },
                             &submission,
                             &rubric.integrity,
                             published,

@@ -25,6 +25,7 @@ use super::rubric::{Output, Rubric};
 use crate::atomic_write::write_file_atomic;
 use crate::case::Case;
 use crate::compare::Image;
+use crate::compare::noise::png_allowance;
 use crate::film::{Film, OutputError, color_image, decode_exr, depth_image, encode_exr, encode_png, normals_image};
 use crate::pipeline::{provenance, render_case_reporting};
 use crate::progress::Progress;
@@ -67,6 +68,10 @@ pub struct Goldens {
     /// Each image's golden film (shared by the images of one render), parallel to
     /// `Rubric::images`: diagnosis renders the mistakes' pictures beside it.
     pub films: Vec<Arc<Film>>,
+    /// For an image judged with `statistical = true`, how far each colour value may stray for the
+    /// golden's sampling noise, in codes (`compare::noise::png_allowance`); parallel to
+    /// `Rubric::images`.
+    pub allowances: Vec<Option<Arc<Vec<[f32; 3]>>>>,
 }
 
 /// Where golden renders are cached unless the caller says otherwise: the user's cache folder
@@ -144,11 +149,18 @@ pub fn prepare_goldens(
     let mut images = Vec::with_capacity(rubric.images.len());
     let mut image_keys = Vec::with_capacity(rubric.images.len());
     let mut image_films = Vec::with_capacity(rubric.images.len());
+    let mut allowances = Vec::with_capacity(rubric.images.len());
     for spec in &rubric.images {
         let film = &films[&spec.render_index];
         image_keys.push(keys[&spec.render_index].clone());
         image_films.push(film.clone());
         let tonemap = rubric.renders[spec.render_index].case.render.tonemap;
+        let statistical = spec.rule.statistical && spec.output == Output::Color;
+        allowances.push(
+            statistical
+                .then(|| png_allowance(film, tonemap).map(Arc::new))
+                .flatten(),
+        );
         let picture: RgbImage = match spec.output {
             Output::Color => color_image(film, tonemap),
             Output::Normals => normals_image(film, tonemap),
@@ -161,6 +173,7 @@ pub fn prepare_goldens(
         images,
         keys: image_keys,
         films: image_films,
+        allowances,
     })
 }
 
@@ -179,12 +192,15 @@ pub fn write_golden_pictures(rubric: &Rubric, goldens: &Goldens, report_dir: &Pa
     Ok(())
 }
 
-/// The cached film, if there is a readable one of the right size. A damaged entry is treated as
+/// The cached film, if there is a readable one of the right size, with the variance channels a
+/// sampled render has (a rubric's `statistical = true` needs them). A damaged entry is treated as
 /// absent and rendered again, which also repairs it.
 fn read_cached(path: &Path, case: &Case) -> Option<Film> {
     let bytes = fs::read(path).ok()?;
     let film = decode_exr(&bytes).ok()?;
-    (film.width == case.render.trace.width && film.height == case.render.trace.height).then_some(film)
+    let trace = &case.render.trace;
+    let complete = film.variance.is_some() == (trace.samples > 1);
+    (film.width == trace.width && film.height == trace.height && complete).then_some(film)
 }
 
 /// The provenance of the rubric's render `index`, computed once per run (it hashes the case and

@@ -50,7 +50,7 @@ pub use outcome::Outcome;
 pub use report::{ClassReport, RubricSummary, diagnoses_of, flags, mistakes_of};
 pub use resume::{RESULT_FILE, StudentRecord};
 pub use rubric::{ImageSpec, Output, RenderSource, Rubric, Rule, load_rubric, parse_rubric};
-pub use score::{ImageResult, StudentResult, Submission, grade_image, judge};
+pub use score::{Golden, ImageResult, StudentResult, Submission, grade_image, judge};
 pub use shard::{MANIFEST, Manifest, Shard, ShardError};
 pub use similarity::{NEAR_IDENTICAL, SimilarPair};
 pub use timing::{RunCost, Timings};

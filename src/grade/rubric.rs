@@ -89,6 +89,10 @@ pub struct Rule {
     pub pass_flip: Option<f64>,
     pub partial_flip: Option<f64>,
     pub partial_credit: f64,
+    /// `statistical = true`: for a colour image of a sampled render, each pixel's threshold is
+    /// widened by the golden's sampling noise (`compare::noise::png_allowance`), so that a
+    /// student's jittered picture is not failed for being jittered differently.
+    pub statistical: bool,
 }
 
 /// Lenient enough for an independent ray tracer's rounding and edge pixels, strict enough that a
@@ -100,6 +104,7 @@ const DEFAULT_RULE: Rule = Rule {
     pass_flip: None,
     partial_flip: None,
     partial_credit: 0.5,
+    statistical: false,
 };
 const DEFAULT_POINTS: f64 = 1.0;
 
@@ -111,6 +116,7 @@ const RULE_KEYS: &[&str] = &[
     "pass_flip",
     "partial_flip",
     "partial_credit",
+    "statistical",
     "points",
 ];
 const IMAGE_KEYS: &[&str] = &["render", "output", "depth"];
@@ -340,13 +346,40 @@ fn image_spec(entry: &Field, renders: &[RenderSource], base: &Rule, base_points:
         (OutputKind::Color, None) => Output::Color,
         (OutputKind::Normals, None) => Output::Normals,
     };
+    let mut rule = rule(&table, base)?;
+    if rule.statistical {
+        let samples = renders[render_index].case.render.trace.samples;
+        let problem = if output != Output::Color {
+            Some(
+                "applies to colour images only: depth and normals come from one ray through each pixel's centre"
+                    .to_owned(),
+            )
+        } else if samples <= 1 {
+            Some(format!(
+                "needs a render with several samples per pixel (`jitter = true`, or a case with `samples`); \
+                 render `{render}` takes {samples}"
+            ))
+        } else {
+            None
+        };
+        match (problem, table.get("statistical")) {
+            // Set on this image: a mistake to point at.
+            (Some(problem), Some(field)) => {
+                let message = format!("`statistical = true` {problem}");
+                return Err(doc.error_at(&field.key_span, message).into());
+            }
+            // Inherited from [defaults]: it applies to the images it can, the others keep the threshold.
+            (Some(_), None) => rule.statistical = false,
+            (None, _) => {}
+        }
+    }
     Ok(ImageSpec {
         file,
         render: render.to_owned(),
         render_index,
         output,
         points: points(&table, base_points)?,
-        rule: rule(&table, base)?,
+        rule,
     })
 }
 
@@ -367,6 +400,7 @@ fn rule(table: &Table, base: &Rule) -> Result<Rule> {
         pass_flip: table.read("pass_flip", base.pass_flip, |f| fraction(f).map(Some))?,
         partial_flip: table.read("partial_flip", base.partial_flip, |f| fraction(f).map(Some))?,
         partial_credit: table.read("partial_credit", base.partial_credit, fraction)?,
+        statistical: table.read("statistical", base.statistical, Field::boolean)?,
     };
     let what = &table.what;
     let problem = if rule.partial_fraction < rule.pass_fraction {

@@ -15,7 +15,7 @@ use super::similarity::Fingerprint;
 use super::submission::{Folder, read_png};
 use super::timing::{Timings, seconds, timed};
 use crate::atomic_write::replace_file;
-use crate::compare::{Image, Metrics, Tolerance, compare_timed, diff_heatmap};
+use crate::compare::{Image, Metrics, Tolerance, compare_timed, diff_heatmap, diff_heatmap_widened};
 use crate::film::{OutputError, encode_png};
 
 /// One expected file of one student.
@@ -113,20 +113,34 @@ impl StudentResult {
     }
 }
 
+/// The golden side of one image: its picture, and with a rubric's `statistical = true` the
+/// allowance each colour value's threshold is widened by (the golden's sampling noise, in codes:
+/// `compare::noise::png_allowance`).
+#[derive(Clone, Copy)]
+pub struct Golden<'a> {
+    pub picture: &'a Image,
+    pub allowance: Option<&'a [[f32; 3]]>,
+}
+
 /// Grades one expected file of one student against its golden picture, writing the student's
 /// picture and the diff heatmap under `out` when they differ from the golden. `published` is the
 /// pixel hash of the published reference image of this file, when the rubric names a published
 /// folder that has it. Whatever the file, the result is a verdict; only a failure to write the
 /// report is an error. `timings` gets the time each step took.
+///
 pub fn grade_image(
     spec: &ImageSpec,
-    golden: &Image,
+    golden: Golden,
     submission: &Submission,
     integrity: &Integrity,
     published: Option<u64>,
     out: &Path,
     timings: &mut Timings,
 ) -> Result<ImageResult, OutputError> {
+    let Golden {
+        picture: golden,
+        allowance,
+    } = golden;
     let (folder, dir) = (&submission.files, submission.dir());
     let mut result = ImageResult {
         file: spec.file.clone(),
@@ -174,7 +188,7 @@ pub fn grade_image(
     };
     let compare_started = Instant::now();
     let actual = Image::from_rgb8(picture.clone(), located.path);
-    let (comparison, flip) = compare_timed(golden, &actual, &tolerance);
+    let (comparison, flip) = compare_timed(golden, &actual, &tolerance, allowance);
     timings.compare += seconds(compare_started.elapsed().saturating_sub(flip));
     timings.flip += seconds(flip);
     let Some(metrics) = comparison.metrics else {
@@ -205,7 +219,11 @@ pub fn grade_image(
     } else {
         replace_file(&out.join(&copy), &encode_png(&actual.preview)?)?;
         result.student_image = Some(copy);
-        if let Some(heatmap) = diff_heatmap(golden, &actual, spec.rule.threshold) {
+        let heatmap = match allowance {
+            Some(allowance) => diff_heatmap_widened(golden, &actual, spec.rule.threshold, allowance),
+            None => diff_heatmap(golden, &actual, spec.rule.threshold),
+        };
+        if let Some(heatmap) = heatmap {
             let stem = spec.file.strip_suffix(".png").unwrap_or(&spec.file);
             let diff = format!("{dir}/{stem}.diff.png");
             replace_file(&out.join(&diff), &encode_png(&heatmap)?)?;
@@ -276,9 +294,14 @@ pub fn judge(rule: &Rule, metrics: &Metrics) -> (Outcome, String) {
         metrics.failing_fraction <= fraction && flip.is_none_or(|limit| metrics.flip <= limit)
     };
     let measured = format!(
-        "{} of pixels differ by more than {} codes{}",
+        "{} of pixels differ by more than {} codes{}{}",
         percent(metrics.failing_fraction),
         rule.threshold,
+        if rule.statistical {
+            " plus the golden's sampling noise"
+        } else {
+            ""
+        },
         rule.pass_flip
             .map_or(String::new(), |_| format!(", FLIP mean {:.4}", metrics.flip)),
     );
@@ -329,6 +352,7 @@ mod tests {
         pass_flip: Some(0.1),
         partial_flip: Some(0.2),
         partial_credit: 0.5,
+        statistical: false,
     };
 
     fn measured(failing_fraction: f64, flip: f64) -> Metrics {

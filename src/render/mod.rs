@@ -2,6 +2,7 @@
 //! What is drawn (camera, lights, materials) belongs to the scene; this module only reads it.
 
 mod faults;
+mod moments;
 pub mod integrator;
 pub mod renderer;
 pub mod sampler;

@@ -5,10 +5,11 @@ use rayon::prelude::*;
 
 use super::faults;
 use super::integrator::Whitted;
-use super::real::{Color, Real, Vec2, Vec3, to_f32};
+use super::real::{Real, Vec2, to_f32};
 use super::sampler::Sampler;
 use super::scene::{Intersection, Scene};
 use crate::fault::{FaultPolicy, FaultSet, NoFaults};
+use super::moments::{MeanOnly, Moments, WithVariance, film_vector};
 use crate::film::Film;
 use crate::options::{Filter, RenderOptions};
 use crate::progress::Progress;
@@ -20,7 +21,6 @@ const BAND_ROWS: usize = 4;
 
 /// The [1 2 1]⊗[1 2 1]/16 kernel over each output pixel's 3×3 block of supersamples.
 const GAUSSIAN_WEIGHTS: [Real; 3] = [0.25, 0.5, 0.25];
-
 
 /// Renders the scene without counting anything.
 pub fn render(scene: &Scene, options: &RenderOptions, progress: &dyn Progress) -> Film {
@@ -56,42 +56,70 @@ fn render_counted<C: RayCounter, F: FaultPolicy>(
     faults: F,
     progress: &dyn Progress,
 ) -> (Film, C) {
+    let sampler = Sampler::with_seeding(options.trace.samples, options.trace.seed, options.seeding);
+    if sampler.samples_per_pixel() > 1 {
+        render_pixels::<C, F, WithVariance>(scene, options, sampler, faults, progress)
+    } else {
+        render_pixels::<C, F, MeanOnly>(scene, options, sampler, faults, progress)
+    }
+}
+
+/// [`render_counted`] with the choice of moments made once per render: `M` is [`WithVariance`]
+/// when a pixel has several samples, [`MeanOnly`] otherwise, so a one-sample render neither
+/// squares a sample nor allocates a variance plane.
+fn render_pixels<C: RayCounter, F: FaultPolicy, M: Moments>(
+    scene: &Scene,
+    options: &RenderOptions,
+    sampler: Sampler,
+    faults: F,
+    progress: &dyn Progress,
+) -> (Film, C) {
     let mut film = Film::new(options.trace.width, options.trace.height);
     let pixels = PixelRenderer {
         scene,
         integrator: Whitted::with_faults(scene, options.trace.bounces, options.trace.shadows, options.spawn, faults),
         faults,
-        sampler: Sampler::new(options.trace.samples, options.trace.seed),
+        sampler,
         options,
     };
     let width = options.trace.width as usize;
     let band = width * BAND_ROWS;
-    let counter = film.color
+    let bands: Vec<(C, M::Band)> = film
+        .color
         .par_chunks_mut(band)
         .zip(film.depth.par_chunks_mut(band))
         .zip(film.normal.par_chunks_mut(band))
         .enumerate()
         .map(|(band_index, ((color, depth), normal))| {
             let mut counter = C::default();
+            let mut variance = M::band(color.len());
             for (offset, ((color, depth), normal)) in color.iter_mut().zip(depth).zip(normal).enumerate() {
                 let index = band_index * band + offset;
                 let (x, y) = ((index % width) as u32, (index / width) as u32);
                 let mut rays = RayCounts::default();
-                let pixel = pixels.pixel(x, y, &mut rays);
+                let pixel = pixels.pixel::<M>(x, y, &mut rays);
                 counter.add(&rays);
-                *color = film_vector(pixel.color);
+                *color = film_vector(pixel.color.mean());
                 *depth = pixel.depth;
                 *normal = pixel.normal;
+                M::store(&mut variance, offset, &pixel.color);
             }
             progress.advance((color.len() / width) as u64);
-            counter
+            (counter, variance)
         })
-        .reduce(C::default, C::merge);
+        .collect();
+    let mut counter = C::default();
+    let mut variances = Vec::with_capacity(bands.len());
+    for (band_counter, variance) in bands {
+        counter = counter.merge(band_counter);
+        variances.push(variance);
+    }
+    film.variance = M::assemble(variances);
     (film, counter)
 }
 
-struct Pixel {
-    color: Color,
+struct Pixel<M> {
+    color: M,
     depth: f32,
     normal: [f32; 3],
 }
@@ -105,26 +133,27 @@ struct PixelRenderer<'a, F: FaultPolicy> {
 }
 
 impl<F: FaultPolicy> PixelRenderer<'_, F> {
-    /// The pixel's colour and AOVs; every ray traced for it is added to `rays`.
-    fn pixel(&self, x: u32, y: u32, rays: &mut RayCounts) -> Pixel {
+    /// The pixel's colour (with its moments `M`) and AOVs; every ray traced for it is added to
+    /// `rays`.
+    fn pixel<M: Moments>(&self, x: u32, y: u32, rays: &mut RayCounts) -> Pixel<M> {
         let (width, height) = (self.options.trace.width, self.options.trace.height);
         let centre = Vec2::new(x as Real + 0.5, y as Real + 0.5);
         match self.options.trace.filter {
             Filter::None if self.sampler.samples_per_pixel() == 1 => {
                 rays.camera += 1;
                 let (color, first) = self.integrator.trace(self.scene.camera.ray(centre, width, height), rays);
-                Pixel::new(color, first.filter(|_| self.options.aovs).as_ref())
+                Pixel::new(M::single(color), first.filter(|_| self.options.aovs).as_ref())
             }
             Filter::None => {
-                let color = self.samples(x, y, width, height, rays);
+                let color = self.samples::<M>(x, y, width, height, rays);
                 Pixel::new(color, self.first_hit(centre, rays).as_ref())
             }
             Filter::Gaussian => {
-                let mut color = Color::ZERO;
+                let mut color = M::zero();
                 for (j, wy) in GAUSSIAN_WEIGHTS.iter().enumerate() {
                     for (i, wx) in GAUSSIAN_WEIGHTS.iter().enumerate() {
-                        let sub = self.samples(3 * x + i as u32, 3 * y + j as u32, 3 * width, 3 * height, rays);
-                        color += sub * (wx * wy);
+                        let sub = self.samples::<M>(3 * x + i as u32, 3 * y + j as u32, 3 * width, 3 * height, rays);
+                        color.add_weighted(&sub, wx * wy);
                     }
                 }
                 Pixel::new(color, self.first_hit(centre, rays).as_ref())
@@ -132,16 +161,18 @@ impl<F: FaultPolicy> PixelRenderer<'_, F> {
         }
     }
 
-    /// Mean colour of a (sub)pixel's stratified samples in an image of `width × height`.
-    fn samples(&self, x: u32, y: u32, width: u32, height: u32, rays: &mut RayCounts) -> Color {
+    /// Mean colour of a (sub)pixel's stratified samples in an image of `width × height`, with
+    /// the variance of that mean when `M` keeps it.
+    fn samples<M: Moments>(&self, x: u32, y: u32, width: u32, height: u32, rays: &mut RayCounts) -> M {
         let count = self.sampler.samples_per_pixel();
         let origin = Vec2::new(x as Real, y as Real);
         rays.camera += u64::from(count);
-        let sum = (0..count).fold(Color::ZERO, |sum, index| {
+        let mut moments = M::Accumulator::default();
+        for index in 0..count {
             let raster = origin + self.sampler.offset(x, y, index);
-            sum + self.integrator.trace(self.scene.camera.ray(raster, width, height), rays).0
-        });
-        sum / count as Real
+            M::push(&mut moments, self.integrator.trace(self.scene.camera.ray(raster, width, height), rays).0);
+        }
+        M::of(moments, count)
     }
 
     /// The AOVs come from one ray through the output pixel's centre: depth and normals averaged
@@ -156,8 +187,8 @@ impl<F: FaultPolicy> PixelRenderer<'_, F> {
     }
 }
 
-impl Pixel {
-    fn new(color: Color, first: Option<&Intersection>) -> Pixel {
+impl<M> Pixel<M> {
+    fn new(color: M, first: Option<&Intersection>) -> Pixel<M> {
         match first {
             Some(hit) => Pixel {
                 color,
@@ -167,13 +198,4 @@ impl Pixel {
             None => Pixel { color, depth: f32::INFINITY, normal: [0.0; 3] },
         }
     }
-}
-
-/// No NaN or infinity may reach a file: a value that overflowed `f32` is clamped to the
-/// largest finite one and a NaN (which valid input cannot produce) becomes zero.
-fn film_vector(v: Vec3) -> [f32; 3] {
-    v.to_array().map(|c| {
-        let c = to_f32(c);
-        if c.is_nan() { 0.0 } else { c.clamp(-f32::MAX, f32::MAX) }
-    })
 }

@@ -10,7 +10,7 @@ use std::sync::{Arc, Mutex};
 use insta::internals::SnapshotContents;
 use insta::{Comparator, Snapshot};
 
-use goldray::compare::{Comparison, Image, Tolerance, Verdict, compare, diff_heatmap};
+use goldray::compare::{Comparison, Image, Tolerance, Verdict, compare, comparison_heatmap};
 use goldray::film::write_png;
 use goldray::provenance::{Provenance, made_differently};
 
@@ -86,7 +86,8 @@ impl ToleranceComparator {
         }
     }
 
-    /// Compares and, unless the render passes outright, writes the heatmap and both previews.
+    /// Compares and, unless the render passes outright, writes the heatmap (of the evidence, for a
+    /// sampled case) and both previews.
     fn report(&self, golden: &Image, render: &Image) -> Comparison {
         let mut comparison = compare(golden, render, &self.tolerance);
         let file = |suffix: &str| self.diffs.join(format!("{}{suffix}.png", self.name));
@@ -98,7 +99,7 @@ impl ToleranceComparator {
         }
         let _ = write_png(&file(".expected"), &golden.preview);
         let _ = write_png(&file(".actual"), &render.preview);
-        if let Some(heatmap) = diff_heatmap(golden, render, self.tolerance.pixel)
+        if let Some(heatmap) = comparison_heatmap(golden, render, &comparison)
             && write_png(&file(""), &heatmap).is_ok()
         {
             comparison.diff_image = Some(PathBuf::from(super::shown(&file(""))));
