@@ -121,6 +121,13 @@ fn check_film(film: &Film, file: &str) -> Result<(), OutputError> {
             variances,
         });
     }
+    let non_finite = |i: usize, channel, value| OutputError::NonFinite {
+        file: file.to_owned(),
+        x: (i % film.width as usize) as u32,
+        y: (i / film.width as usize) as u32,
+        channel,
+        value,
+    };
     let pixel_values = film.color.iter().zip(&film.depth).zip(&film.normal);
     for (i, ((color, &depth), normal)) in pixel_values.enumerate() {
         let values = [color[0], color[1], color[2], depth, normal[0], normal[1], normal[2]];
@@ -132,13 +139,7 @@ fn check_film(film: &Film, file: &str) -> Result<(), OutputError> {
             }
         });
         if let Some((&value, channel)) = bad {
-            return Err(OutputError::NonFinite {
-                file: file.to_owned(),
-                x: (i % film.width as usize) as u32,
-                y: (i / film.width as usize) as u32,
-                channel,
-                value,
-            });
+            return Err(non_finite(i, channel, value));
         }
     }
     let variances = film.variance.iter().flatten().enumerate();
@@ -151,13 +152,7 @@ fn check_film(film: &Film, file: &str) -> Result<(), OutputError> {
         .into_iter()
         .find(|&(_, value, _)| !(value.is_finite() && value >= 0.0))
     {
-        return Err(OutputError::NonFinite {
-            file: file.to_owned(),
-            x: (i % film.width as usize) as u32,
-            y: (i / film.width as usize) as u32,
-            channel,
-            value,
-        });
+        return Err(non_finite(i, channel, value));
     }
     Ok(())
 }

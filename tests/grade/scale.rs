@@ -30,6 +30,32 @@ fn text(path: &Path) -> String {
     path.to_str().unwrap().to_owned()
 }
 
+/// `goldray grade` of slice `index` of `count` into `out`, which must succeed.
+fn grade_shard(
+    rubric: &str,
+    submissions: &str,
+    (index, count): (usize, usize),
+    out: &Path,
+    cache: &str,
+    extra: &[&str],
+) {
+    let (slice, out) = (format!("{index}/{count}"), text(out));
+    let mut args = vec![
+        "grade",
+        "--rubric",
+        rubric,
+        submissions,
+        "--shard",
+        &slice,
+        "--out",
+        &out,
+        "--cache",
+        cache,
+    ];
+    args.extend(extra);
+    succeeded(&goldray(&args));
+}
+
 /// Every file under `dir` with its bytes, by relative path, except what says how one run went
 /// (`run.json`, and each student's `result.json`, which keeps the student's timings) or which
 /// slice it was (`shard.json`).
@@ -140,18 +166,7 @@ fn shards_merged_give_the_report_of_one_run_and_only_read_the_prepared_cache() {
         let dirs: Vec<String> = (1..=count)
             .map(|index| {
                 let dir = class.dir.join(format!("shards-{count}/{index}"));
-                succeeded(&goldray(&[
-                    "grade",
-                    "--rubric",
-                    &rubric,
-                    &submissions,
-                    "--shard",
-                    &format!("{index}/{count}"),
-                    "--out",
-                    &text(&dir),
-                    "--cache",
-                    &text(&cache),
-                ]));
+                grade_shard(&rubric, &submissions, (index, count), &dir, &text(&cache), &[]);
                 assert_eq!(
                     dir.join("grades.csv").exists(),
                     count == 1,
@@ -198,19 +213,7 @@ fn bad_shard_arguments_and_shard_sets_are_refused_with_the_reason() {
     }
     let shard = |rubric: &str, index: usize, count: usize, name: &str| {
         let dir = class.dir.join(name);
-        succeeded(&goldray(&[
-            "grade",
-            "--rubric",
-            rubric,
-            &submissions,
-            "--shard",
-            &format!("{index}/{count}"),
-            "--out",
-            &text(&dir),
-            "--cache",
-            &cache,
-            "--no-diagnose",
-        ]));
+        grade_shard(rubric, &submissions, (index, count), &dir, &cache, &["--no-diagnose"]);
         text(&dir)
     };
     let (first, second, third) = (
