@@ -17,8 +17,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use goldray::fault::{Fault, FaultSet};
-use goldray::film::{Picture, Tonemap, encode_png, picture_with_faults};
-use goldray::grade::{ClassReport, Diagnose, GradeOptions, Output, grade_class_diagnosing, load_rubric};
+use goldray::film::{Tonemap, encode_png, picture_with_faults};
+use goldray::grade::{ClassReport, Diagnose, GradeOptions, grade_class_diagnosing, load_rubric};
 use goldray::pipeline::{FaultRenderer, fault_applies};
 use goldray::progress::Silent;
 
@@ -62,14 +62,7 @@ fn main() {
             let film = films
                 .entry(spec.render_index)
                 .or_insert_with(|| renderers[spec.render_index].render(&faults.render_part()).unwrap());
-            let picture = match spec.output {
-                Output::Color => Picture::Color,
-                Output::Normals => Picture::Normals,
-                Output::Depth { min, max } => Picture::Depth {
-                    min: min as f32,
-                    max: max as f32,
-                },
-            };
+            let picture = spec.output.picture();
             let image = picture_with_faults(film, picture, Tonemap::Clamp, &faults);
             fs::write(folder.join(&spec.file), encode_png(&image).unwrap()).unwrap();
         }

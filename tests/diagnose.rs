@@ -21,8 +21,8 @@ use std::time::Instant;
 
 use goldray::case::Case;
 use goldray::fault::{Fault, FaultSet};
-use goldray::film::{Picture, encode_png, picture_with_faults};
-use goldray::grade::{ClassReport, GradeOptions, Output, StudentResult, UNEXPLAINED, grade_class, load_rubric};
+use goldray::film::{encode_png, picture_with_faults};
+use goldray::grade::{ClassReport, GradeOptions, StudentResult, UNEXPLAINED, grade_class, load_rubric};
 use goldray::pipeline::{FaultRenderer, fault_applies};
 use goldray::progress::Silent;
 use image::{Rgb, RgbImage};
@@ -79,14 +79,7 @@ fn write_student(
         let film = films
             .entry(spec.render_index)
             .or_insert_with(|| renderers[spec.render_index].render(&faults.render_part()).unwrap());
-        let picture = match spec.output {
-            Output::Color => Picture::Color,
-            Output::Normals => Picture::Normals,
-            Output::Depth { min, max } => Picture::Depth {
-                min: min as f32,
-                max: max as f32,
-            },
-        };
+        let picture = spec.output.picture();
         let mut image = picture_with_faults(film, picture, goldray::film::Tonemap::Clamp, faults);
         if perturbation == Perturbation::Independent {
             image = noise(&image, 1);

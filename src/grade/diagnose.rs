@@ -38,7 +38,7 @@ use image::RgbImage;
 
 use super::diagnosis::{Closest, Confidence, Diagnosis, DiagnosisRun, RenderDiagnosis, Residual, UNEXPLAINED};
 use super::outcome::Outcome;
-use super::rubric::{ImageSpec, Output, Rubric, Rule};
+use super::rubric::{ImageSpec, Rubric, Rule};
 use super::score::{ImageResult, StudentResult, judge};
 use crate::atomic_write::replace_file;
 use crate::compare::{Image, Tolerance, compare, diff_heatmap};
@@ -182,17 +182,6 @@ impl Subject<'_> {
             golden,
             speckle,
         }
-    }
-}
-
-fn film_picture(output: Output) -> Picture {
-    match output {
-        Output::Color => Picture::Color,
-        Output::Normals => Picture::Normals,
-        Output::Depth { min, max } => Picture::Depth {
-            min: min as f32,
-            max: max as f32,
-        },
     }
 }
 

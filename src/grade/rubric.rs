@@ -12,6 +12,7 @@ use super::error::RubricError;
 use super::integrity::{Integrity, integrity};
 use crate::case::{self, AssignmentOptions, Case, LoadOptions, MAX_BOUNCES, load_assignment_scene};
 use crate::fault::Fault;
+use crate::film::Picture;
 use crate::image_size::{MAX_IMAGE_SIZE, SizeLimit, check_side};
 use crate::located_toml::{self, Doc, Field, ReadError, SourceLocation, Table, suggest};
 use crate::named_enum::NamedEnum;
@@ -54,6 +55,20 @@ pub enum Output {
         min: f64,
         max: f64,
     },
+}
+
+impl Output {
+    /// The film's picture this image is, for drawing it (goldens, diagnosis, test students).
+    pub fn picture(self) -> Picture {
+        match self {
+            Output::Color => Picture::Color,
+            Output::Normals => Picture::Normals,
+            Output::Depth { min, max } => Picture::Depth {
+                min: min as f32,
+                max: max as f32,
+            },
+        }
+    }
 }
 
 named_enum! {

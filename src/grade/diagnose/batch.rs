@@ -16,7 +16,7 @@ use super::super::score::StudentResult;
 use super::super::submission::read_png;
 use super::{
     Candidate, Diagnosis, DiagnosisRun, RenderDiagnosis, Scored, Subject, UNEXPLAINED, candidates, decide, expansions,
-    film_picture, fit_background, fit_gamma, loses_points, pictures, residual, student_dir,
+    fit_background, fit_gamma, loses_points, pictures, residual, student_dir,
 };
 use crate::fault::FaultSet;
 use crate::film::Picture;
@@ -133,7 +133,7 @@ impl<'a> Diagnoser<'a> {
                 .par_iter()
                 .map(|&(s, i)| {
                     let spec = &rubric.images[i];
-                    let index = store.pictures().iter().position(|p| *p == film_picture(spec.output))?;
+                    let index = store.pictures().iter().position(|p| *p == spec.output.picture())?;
                     let file = students[s].images[i].graded_file.as_ref()?;
                     let student = read_png(file).ok()?.picture;
                     let golden = &golden_pictures[index];
@@ -320,7 +320,7 @@ fn render_groups(goldens: &Goldens) -> Vec<(&str, Vec<usize>)> {
 fn distinct_pictures(rubric: &Rubric, images: &mut dyn Iterator<Item = usize>) -> Vec<Picture> {
     let mut pictures: Vec<Picture> = Vec::new();
     for i in images {
-        let picture = film_picture(rubric.images[i].output);
+        let picture = rubric.images[i].output.picture();
         if !pictures.contains(&picture) {
             pictures.push(picture);
         }
