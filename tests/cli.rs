@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 mod util;
 
 use goldray::provenance::{Group, Provenance, keys, strip};
-use util::{goldray, shipped as case, stderr};
+use util::{goldray, render_on_threads, shipped as case, stderr};
 
 fn files_in(dir: &Path) -> Vec<String> {
     let mut names: Vec<String> = match fs::read_dir(dir) {
@@ -69,16 +69,7 @@ fn exr_is_bit_identical_with_one_and_two_threads() {
         let mut bytes = Vec::new();
         for threads in ["1", "2"] {
             let out = tempfile::tempdir().unwrap();
-            let result = goldray(&[
-                "render",
-                case(name).to_str().unwrap(),
-                "--out",
-                out.path().to_str().unwrap(),
-                "--threads",
-                threads,
-                "--quiet",
-            ]);
-            assert!(result.status.success(), "{name}: {}", stderr(&result));
+            render_on_threads(&case(name), out.path(), threads, &[]);
             let stem = name.trim_end_matches(".toml");
             bytes.push(fs::read(out.path().join(format!("{stem}.exr"))).unwrap());
         }

@@ -14,7 +14,7 @@ use exr::meta::attribute::AttributeValue;
 use goldray::provenance::{ContentHash, Group, Provenance, build_commit, keys, strip};
 use tempfile::TempDir;
 
-use util::{goldray, project_file, stderr};
+use util::{goldray, project_file, render_on_threads, stderr};
 
 /// A tiny case reading one mesh, so that the hash must cover an asset.
 fn tiny_case(seed: u64) -> String {
@@ -40,16 +40,7 @@ fn write_case(dir: &Path, seed: u64) -> PathBuf {
 
 /// Renders `case` into `out` on `threads` threads.
 fn render(case: &Path, out: &Path, threads: &str) {
-    let result = goldray(&[
-        "render",
-        case.to_str().unwrap(),
-        "--out",
-        out.to_str().unwrap(),
-        "--threads",
-        threads,
-        "--quiet",
-    ]);
-    assert!(result.status.success(), "{}", stderr(&result));
+    render_on_threads(case, out, threads, &[]);
 }
 
 /// The EXR's `string` attributes as the exr crate reads them.

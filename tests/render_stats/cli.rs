@@ -9,7 +9,7 @@ use goldray::options::Filter;
 use goldray::provenance::{Group, strip};
 use serde_json::Value;
 
-use crate::util::{goldray, shipped as shipped_case, stderr};
+use crate::util::{goldray, render_on_threads, shipped as shipped_case, stderr};
 
 fn read_json(path: &Path) -> Value {
     serde_json::from_slice(&fs::read(path).unwrap()).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
@@ -85,18 +85,7 @@ fn json_counts_are_the_same_on_one_and_two_threads() {
         .map(|threads| {
             let json = dir.path().join(format!("{threads}.json"));
             let out = dir.path().join(threads);
-            let result = goldray(&[
-                "render",
-                case.to_str().unwrap(),
-                "--out",
-                out.to_str().unwrap(),
-                "--threads",
-                threads,
-                "--quiet",
-                "--stats-json",
-                json.to_str().unwrap(),
-            ]);
-            assert!(result.status.success(), "{}", stderr(&result));
+            render_on_threads(&case, &out, threads, &["--stats-json", json.to_str().unwrap()]);
             read_json(&json)
         })
         .collect();

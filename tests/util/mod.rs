@@ -33,3 +33,12 @@ pub fn shipped(file: &str) -> PathBuf {
 pub fn load_shipped(name: &str) -> Case {
     load(&shipped(&format!("{name}.toml")), &LoadOptions::default()).unwrap_or_else(|e| panic!("{e}"))
 }
+
+/// `goldray render CASE --out OUT --threads THREADS --quiet EXTRA…`, which must succeed.
+pub fn render_on_threads(case: &Path, out: &Path, threads: &str, extra: &[&str]) {
+    let (case, out) = (case.to_str().expect("UTF-8 path"), out.to_str().expect("UTF-8 path"));
+    let mut args = vec!["render", case, "--out", out, "--threads", threads, "--quiet"];
+    args.extend(extra);
+    let result = goldray(&args);
+    assert!(result.status.success(), "{case}: {}", stderr(&result));
+}
