@@ -26,7 +26,7 @@ use crate::atomic_write::write_file_atomic;
 use crate::case::Case;
 use crate::compare::Image;
 use crate::compare::noise::png_allowance;
-use crate::film::{Film, OutputError, color_image, decode_exr, depth_image, encode_exr, encode_png, normals_image};
+use crate::film::{Film, OutputError, decode_exr, encode_exr, encode_png, picture};
 use crate::pipeline::{provenance, render_case_reporting};
 use crate::progress::Progress;
 use crate::provenance::Provenance;
@@ -72,6 +72,9 @@ pub struct Goldens {
     /// golden's sampling noise, in codes (`compare::noise::png_allowance`); parallel to
     /// `Rubric::images`.
     pub allowances: Vec<Option<Arc<Vec<[f32; 3]>>>>,
+    /// The provenance of each render an image uses, by render index (the stable group only, as
+    /// the cache and the report's golden pictures are compared by content).
+    pub provenances: HashMap<usize, Provenance>,
 }
 
 /// Where golden renders are cached unless the caller says otherwise: the user's cache folder
@@ -151,6 +154,7 @@ pub fn prepare_goldens(
     let mut image_films = Vec::with_capacity(rubric.images.len());
     let mut allowances = Vec::with_capacity(rubric.images.len());
     for spec in &rubric.images {
+        provenance_of(rubric, spec.render_index, &mut provenances)?;
         let film = &films[&spec.render_index];
         image_keys.push(keys[&spec.render_index].clone());
         image_films.push(film.clone());
@@ -161,12 +165,8 @@ pub fn prepare_goldens(
                 .then(|| png_allowance(film, tonemap).map(Arc::new))
                 .flatten(),
         );
-        let picture: RgbImage = match spec.output {
-            Output::Color => color_image(film, tonemap),
-            Output::Normals => normals_image(film, tonemap),
-            Output::Depth { min, max } => depth_image(film, min as f32, max as f32, tonemap),
-        };
-        images.push(Image::from_rgb8(picture, Path::new(GOLDEN_DIR).join(&spec.file)));
+        let golden = picture(film, spec.output.picture(), tonemap);
+        images.push(Image::from_rgb8(golden, Path::new(GOLDEN_DIR).join(&spec.file)));
     }
     Ok(Goldens {
         renders,
@@ -174,15 +174,15 @@ pub fn prepare_goldens(
         keys: image_keys,
         films: image_films,
         allowances,
+        provenances,
     })
 }
 
 /// Writes each golden picture to `REPORT/golden/FILE`, for the HTML report.
 /// Each carries the provenance of its render.
-pub fn write_golden_pictures(rubric: &Rubric, goldens: &Goldens, report_dir: &Path) -> Result<(), GradeError> {
-    let mut provenances = HashMap::new();
+pub fn write_golden_pictures(rubric: &Rubric, goldens: &Goldens, report_dir: &Path) -> Result<(), OutputError> {
     for (spec, image) in rubric.images.iter().zip(&goldens.images) {
-        let provenance = provenance_of(rubric, spec.render_index, &mut provenances)?;
+        let provenance = &goldens.provenances[&spec.render_index];
         write_golden_png(
             &report_dir.join(GOLDEN_DIR).join(&spec.file),
             &image.preview,
