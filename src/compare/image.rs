@@ -2,12 +2,14 @@
 //! sRGB picture that FLIP and the diff heatmap need.
 
 use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
 
 use ::exr::meta::MetaData;
 use image::RgbImage;
 use serde::{Deserialize, Serialize};
 
 use super::error::CompareError;
+use super::flip::Maps;
 use crate::film::{Film, Tonemap, color_image, decode_exr};
 
 /// The EXR channels goldray writes and reads, in the contract's order. Other channels in a file
@@ -67,6 +69,9 @@ pub struct Image {
     pub variance: Option<Vec<[f32; 3]>>,
     /// The colour as a person sees it: FLIP's input and the heatmap's backdrop.
     pub preview: RgbImage,
+    /// FLIP's maps of `preview`, made the first time a differing picture is compared against
+    /// this one and kept for the next: a golden image is the reference of a whole class.
+    pub(super) flip: OnceLock<Maps>,
 }
 
 impl Image {
@@ -91,6 +96,7 @@ impl Image {
                 .collect(),
             variance: None,
             preview: picture,
+            flip: OnceLock::new(),
         }
     }
 
@@ -175,6 +181,7 @@ impl Image {
             channels,
             variance: film.variance.clone(),
             preview: color_image(film, Tonemap::Srgb),
+            flip: OnceLock::new(),
         }
     }
 }
