@@ -51,34 +51,58 @@ fn heatmap_with(expected: &Image, actual: &Image, pixel_threshold: f64, colour: 
         return None;
     }
     let width = expected.width as usize;
-    Some(RgbImage::from_fn(expected.width, expected.height, |x, y| {
-        let i = y as usize * width + x as usize;
-        let mut largest = 0.0_f64;
-        let mut failing = false;
-        for (e, a) in expected.channels.iter().zip(&actual.channels) {
-            let colour_index = COLOR_CHANNELS.iter().position(|&c| c == e.name);
-            match difference(e.values[i], a.values[i], e.infinity_is_a_value()) {
-                Difference::Broken => return Rgb(NON_FINITE),
-                diff @ (Difference::Finite(_) | Difference::Coverage) => {
-                    failing |= match colour_index {
-                        Some(c) => colour.fails(diff, pixel_threshold, i, c),
-                        None => diff.exceeds(pixel_threshold),
-                    };
-                    if let Difference::Finite(d) = diff {
-                        largest = largest.max(d);
+    let colour_indices: Vec<Option<usize>> = expected
+        .channels
+        .iter()
+        .map(|e| COLOR_CHANNELS.iter().position(|&c| c == e.name))
+        .collect();
+    let mut heatmap = RgbImage::from_fn(expected.width, expected.height, |x, y| backdrop(expected, x, y));
+    for y in 0..expected.height {
+        let row = y as usize * width..(y as usize + 1) * width;
+        // A row equal in every channel is all backdrop (a zero difference fails no threshold
+        // that is not negative): most rows of a graded picture.
+        if pixel_threshold >= 0.0
+            && expected
+                .channels
+                .iter()
+                .zip(&actual.channels)
+                .all(|(e, a)| e.values[row.clone()] == a.values[row.clone()])
+        {
+            continue;
+        }
+        for x in 0..expected.width {
+            let i = row.start + x as usize;
+            let mut largest = 0.0_f64;
+            let mut failing = false;
+            let mut broken = false;
+            for ((e, a), colour_index) in expected.channels.iter().zip(&actual.channels).zip(&colour_indices) {
+                match difference(e.values[i], a.values[i], e.infinity_is_a_value()) {
+                    Difference::Broken => broken = true,
+                    diff @ (Difference::Finite(_) | Difference::Coverage) => {
+                        failing |= match colour_index {
+                            Some(c) => colour.fails(diff, pixel_threshold, i, *c),
+                            None => diff.exceeds(pixel_threshold),
+                        };
+                        if let Difference::Finite(d) = diff {
+                            largest = largest.max(d);
+                        }
                     }
                 }
             }
+            let pixel = if broken {
+                Rgb(NON_FINITE)
+            } else if failing {
+                Rgb(FAILING)
+            } else if largest == 0.0 {
+                continue;
+            } else {
+                let t = ((largest / pixel_threshold).log10() / DECADES + 1.0).clamp(0.0, 1.0) as f32;
+                hot(expected, x, y, t)
+            };
+            heatmap.put_pixel(x, y, pixel);
         }
-        if failing {
-            return Rgb(FAILING);
-        }
-        if largest == 0.0 {
-            return backdrop(expected, x, y);
-        }
-        let t = ((largest / pixel_threshold).log10() / DECADES + 1.0).clamp(0.0, 1.0) as f32;
-        hot(expected, x, y, t)
-    }))
+    }
+    Some(heatmap)
 }
 
 /// The heatmap that fits `comparison`: the evidence of a statistical one, the differences of any

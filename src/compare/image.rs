@@ -9,7 +9,7 @@ use image::RgbImage;
 use serde::{Deserialize, Serialize};
 
 use super::error::CompareError;
-use super::flip::Maps;
+use super::flip::Reference;
 use crate::film::{Film, Tonemap, color_image, decode_exr};
 
 /// The EXR channels goldray writes and reads, in the contract's order. Other channels in a file
@@ -69,9 +69,10 @@ pub struct Image {
     pub variance: Option<Vec<[f32; 3]>>,
     /// The colour as a person sees it: FLIP's input and the heatmap's backdrop.
     pub preview: RgbImage,
-    /// FLIP's maps of `preview`, made the first time a differing picture is compared against
-    /// this one and kept for the next: a golden image is the reference of a whole class.
-    pub(super) flip: OnceLock<Maps>,
+    /// What FLIP keeps of `preview` as a reference, made the first time a differing picture is
+    /// compared against this one and kept for the next: a golden image is the reference of a
+    /// whole class.
+    pub(super) flip: OnceLock<Reference>,
 }
 
 impl Image {
@@ -83,7 +84,8 @@ impl Image {
 
     /// Code values as stored: a PNG is compared as the bytes a viewer shows.
     pub fn from_rgb8(picture: RgbImage, source: impl Into<PathBuf>) -> Image {
-        let plane = |c: usize| picture.pixels().map(|p| f32::from(p.0[c])).collect();
+        let planes: [Vec<f32>; 3] =
+            std::array::from_fn(|c| picture.as_raw().chunks_exact(3).map(|p| f32::from(p[c])).collect());
         Image {
             source: source.into(),
             encoding: Encoding::Code8,
@@ -91,8 +93,8 @@ impl Image {
             height: picture.height(),
             channels: COLOR_CHANNELS
                 .iter()
-                .enumerate()
-                .map(|(c, &name)| Channel { name, values: plane(c) })
+                .zip(planes)
+                .map(|(&name, values)| Channel { name, values })
                 .collect(),
             variance: None,
             preview: picture,

@@ -4,6 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use fast_image_resize::{FilterType, ResizeAlg, ResizeOptions, Resizer};
 use serde::{Deserialize, Serialize};
 
 use super::diagnosis::Diagnosis;
@@ -267,7 +268,14 @@ fn thumbnail(picture: &image::RgbImage) -> image::RgbImage {
         return picture.clone();
     }
     let scale = |side: u32| ((u64::from(side) * u64::from(THUMBNAIL)) / u64::from(longest)).max(1) as u32;
-    image::imageops::thumbnail(picture, scale(width), scale(height))
+    let mut small = image::RgbImage::new(scale(width), scale(height));
+    let area_average = ResizeOptions::new().resize_alg(ResizeAlg::Convolution(FilterType::Box));
+    match Resizer::new().resize(picture, &mut small, &area_average) {
+        Ok(()) => small,
+        // Both are 8-bit RGB pictures, which the resizer takes; should it refuse one anyway, the
+        // report still gets a thumbnail.
+        Err(_) => image::imageops::thumbnail(picture, small.width(), small.height()),
+    }
 }
 
 /// A result with nothing compared: no points, and the outcome's reason as the explanation.

@@ -132,7 +132,9 @@ impl Folder {
                 .ok()
                 .filter(|m| m.is_file() && m.len() <= MAX_FILE_BYTES)
                 .and_then(|_| fs::read(&located.path).ok());
-            bytes.hash(hasher);
+            // The file's BLAKE3 digest stands for its bytes: several times faster to compute
+            // than feeding megabytes to `hasher`.
+            bytes.map(|b| *blake3::hash(&b).as_bytes()).hash(hasher);
         }
     }
 }

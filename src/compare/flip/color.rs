@@ -43,13 +43,20 @@ pub(super) fn feature_input(achromatic: f32) -> f32 {
     achromatic * (1.0 / 116.0) + 16.0 / 116.0
 }
 
-/// The colour error of two spatially filtered YCxCz values, in [0, 1].
+/// A spatially filtered YCxCz value as FLIP compares colours: clamped to the display's gamut,
+/// in CIELAB with the Hunt adjustment.
+pub(super) fn perceived(ycxcz: [f32; 3]) -> [f32; 3] {
+    let [r, g, b] = xyz_to_linear_rgb(ycxcz_to_xyz(ycxcz));
+    hunt(xyz_to_lab(linear_rgb_to_xyz([
+        r.clamp(0.0, 1.0),
+        g.clamp(0.0, 1.0),
+        b.clamp(0.0, 1.0),
+    ])))
+}
+
+/// The colour error of two [`perceived`] colours, in [0, 1].
 pub(super) fn color_error(reference: [f32; 3], test: [f32; 3]) -> f32 {
-    let perceived = |ycxcz: [f32; 3]| {
-        let rgb = xyz_to_linear_rgb(ycxcz_to_xyz(ycxcz)).map(|c| c.clamp(0.0, 1.0));
-        hunt(xyz_to_lab(linear_rgb_to_xyz(rgb)))
-    };
-    let difference = hyab(perceived(reference), perceived(test)).powf(QC);
+    let difference = hyab(reference, test).powf(QC);
     let max = *MAX_DISTANCE;
     let knee = PC * max;
     if difference < knee {
@@ -59,12 +66,16 @@ pub(super) fn color_error(reference: [f32; 3], test: [f32; 3]) -> f32 {
     }
 }
 
+/// The edge and point strengths of the feature responses `[dx, dy, ddx, ddy]`.
+pub(super) fn strengths([dx, dy, ddx, ddy]: [f32; 4]) -> [f32; 2] {
+    [(dx * dx + dy * dy).sqrt(), (ddx * ddx + ddy * ddy).sqrt()]
+}
+
 /// FLIP's error at a pixel: the colour error raised to one minus the feature difference, given
-/// both images' edge and point responses `[dx, dy, ddx, ddy]`.
-pub(super) fn flip_error(color_error: f32, reference: [f32; 4], test: [f32; 4]) -> f32 {
-    let magnitude = |a: f32, b: f32| (a * a + b * b).sqrt();
-    let edge = (magnitude(reference[0], reference[1]) - magnitude(test[0], test[1])).abs();
-    let point = (magnitude(reference[2], reference[3]) - magnitude(test[2], test[3])).abs();
+/// both images' edge and point [`strengths`].
+pub(super) fn flip_error(color_error: f32, reference: [f32; 2], test: [f32; 2]) -> f32 {
+    let edge = (reference[0] - test[0]).abs();
+    let point = (reference[1] - test[1]).abs();
     let feature = ((1.0 / 2.0f32.sqrt()) * if edge > point { edge } else { point }).powf(QF);
     color_error.powf(1.0 - feature)
 }

@@ -1,41 +1,77 @@
-//! FLIP's filtered maps of a whole picture: the spatially filtered colour and the edge and point
+//! FLIP's filtered maps of a picture: the spatially filtered colour and the edge and point
 //! responses, by separable filtering with edge values repeated past the border, each pixel's taps
 //! summed in the reference implementation's order (so that the maps round as its maps do).
 
+use std::ops::Range;
+
 use image::RgbImage;
 
-use super::color::{feature_input, srgb_to_ycxcz};
+use super::color::{feature_input, perceived, srgb_to_ycxcz, strengths};
 use super::kernels::KERNELS;
 
-/// What FLIP's per-pixel error reads of one picture.
+/// What FLIP's per-pixel error reads of one picture, over a band of its rows.
 #[derive(Clone)]
-pub(in crate::compare) struct Maps {
+pub(super) struct Maps {
+    width: usize,
+    rows: Range<usize>,
     /// The spatially filtered YCxCz, one plane per channel.
     color: [Vec<f32>; 3],
     /// The edge and point responses `dx, dy, ddx, ddy`.
     features: [Vec<f32>; 4],
 }
 
-impl std::fmt::Debug for Maps {
+/// What FLIP keeps of a reference picture to compare others with it: its maps over the whole
+/// picture and what its half of every pixel's error needs of them.
+#[derive(Clone)]
+pub(in crate::compare) struct Reference {
+    pub(super) maps: Maps,
+    /// Each pixel's filtered colour as FLIP compares colours ([`perceived`]).
+    pub(super) perceived: Vec<[f32; 3]>,
+    /// Each pixel's edge and point [`strengths`].
+    pub(super) strengths: Vec<[f32; 2]>,
+}
+
+impl std::fmt::Debug for Reference {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "Maps({} pixels)", self.color[0].len())
+        write!(f, "flip::Reference({} pixels)", self.perceived.len())
+    }
+}
+
+impl Reference {
+    pub(super) fn of(picture: &RgbImage) -> Reference {
+        let maps = Maps::of(picture, 0..picture.height() as usize);
+        let pixels = maps.color[0].len();
+        Reference {
+            perceived: (0..pixels).map(|p| perceived(maps.color(p))).collect(),
+            strengths: (0..pixels).map(|p| strengths(maps.features(p))).collect(),
+            maps,
+        }
     }
 }
 
 impl Maps {
-    pub fn of(picture: &RgbImage) -> Maps {
+    /// The maps of `picture`'s rows `rows`, exactly as over the whole picture (each read the
+    /// picture's rows within the filters' reach).
+    pub fn of(picture: &RgbImage, rows: Range<usize>) -> Maps {
         let (width, height) = (picture.width() as usize, picture.height() as usize);
-        let pixels = width * height;
-        let mut opponent: [Vec<f32>; 3] = std::array::from_fn(|_| Vec::with_capacity(pixels));
-        for pixel in picture.pixels() {
-            let value = srgb_to_ycxcz(pixel.0);
+        let k = &*KERNELS;
+        let reach = k.spatial_radius().max(k.feature_radius());
+        let read = rows.start.saturating_sub(reach)..(rows.end + reach).min(height);
+        let mut opponent: [Vec<f32>; 3] = std::array::from_fn(|_| Vec::with_capacity(read.len() * width));
+        let bytes = &picture.as_raw()[read.start * width * 3..read.end * width * 3];
+        for pixel in bytes.chunks_exact(3) {
+            let value = srgb_to_ycxcz([pixel[0], pixel[1], pixel[2]]);
             for (plane, v) in opponent.iter_mut().zip(value) {
                 plane.push(v);
             }
         }
-        let k = &*KERNELS;
-        let filter =
-            |plane: &[f32], across: &[f32], down: &[f32]| vertical(&horizontal(plane, width, across), width, down);
+        let band = Band {
+            width,
+            height,
+            read,
+            rows: rows.clone(),
+        };
+        let filter = |plane: &[f32], across: &[f32], down: &[f32]| band.vertical(&band.horizontal(plane, across), down);
         let first_blue_yellow = filter(&opponent[2], &k.blue_yellow[0], &k.blue_yellow[0]);
         let second_blue_yellow = filter(&opponent[2], &k.blue_yellow[1], &k.blue_yellow[1]);
         let color = [
@@ -48,56 +84,86 @@ impl Maps {
                 .collect(),
         ];
         let gray: Vec<f32> = opponent[0].iter().map(|&y| feature_input(y)).collect();
-        let smoothed = horizontal(&gray, width, &k.gaussian);
+        let smoothed = band.horizontal(&gray, &k.gaussian);
         let features = [
-            vertical(&horizontal(&gray, width, &k.first), width, &k.gaussian),
-            vertical(&smoothed, width, &k.first),
-            vertical(&horizontal(&gray, width, &k.second), width, &k.gaussian),
-            vertical(&smoothed, width, &k.second),
+            band.vertical(&band.horizontal(&gray, &k.first), &k.gaussian),
+            band.vertical(&smoothed, &k.first),
+            band.vertical(&band.horizontal(&gray, &k.second), &k.gaussian),
+            band.vertical(&smoothed, &k.second),
         ];
-        debug_assert!(color.iter().chain(&features).all(|plane| plane.len() == height * width));
-        Maps { color, features }
+        Maps {
+            width,
+            rows,
+            color,
+            features,
+        }
     }
 
+    /// The pixels (indices into the whole picture) the maps cover.
+    pub fn pixels(&self) -> Range<usize> {
+        self.rows.start * self.width..self.rows.end * self.width
+    }
+
+    /// The filtered colour at `pixel`, an index into the whole picture within [`Maps::pixels`].
     pub fn color(&self, pixel: usize) -> [f32; 3] {
-        self.color.each_ref().map(|plane| plane[pixel])
+        let i = pixel - self.rows.start * self.width;
+        [self.color[0][i], self.color[1][i], self.color[2][i]]
     }
 
+    /// The feature responses at `pixel`, as [`Maps::color`].
     pub fn features(&self, pixel: usize) -> [f32; 4] {
-        self.features.each_ref().map(|plane| plane[pixel])
+        let i = pixel - self.rows.start * self.width;
+        [
+            self.features[0][i],
+            self.features[1][i],
+            self.features[2][i],
+            self.features[3][i],
+        ]
     }
 }
 
-/// Each row filtered by `taps`, the row's end values repeated past its ends.
-fn horizontal(plane: &[f32], width: usize, taps: &[f32]) -> Vec<f32> {
-    let radius = taps.len() / 2;
-    let mut out = vec![0.0f32; plane.len()];
-    let mut padded = vec![0.0f32; width + 2 * radius];
-    for (row, out_row) in plane.chunks_exact(width).zip(out.chunks_exact_mut(width)) {
-        for (i, p) in padded.iter_mut().enumerate() {
-            *p = row[i.saturating_sub(radius).min(width - 1)];
-        }
-        for (t, &tap) in taps.iter().enumerate() {
-            for (o, &v) in out_row.iter_mut().zip(&padded[t..t + width]) {
-                *o += tap * v;
-            }
-        }
-    }
-    out
+/// The rows a band's maps cover and the rows they read.
+struct Band {
+    width: usize,
+    height: usize,
+    /// The picture's rows the planes hold (the band and the filters' reach).
+    read: Range<usize>,
+    rows: Range<usize>,
 }
 
-/// Each column filtered by `taps`, the column's end values repeated past its ends.
-fn vertical(plane: &[f32], width: usize, taps: &[f32]) -> Vec<f32> {
-    let radius = taps.len() / 2;
-    let height = plane.len() / width;
-    let mut out = vec![0.0f32; plane.len()];
-    for (y, out_row) in out.chunks_exact_mut(width).enumerate() {
-        for (t, &tap) in taps.iter().enumerate() {
-            let source = (y + t).saturating_sub(radius).min(height - 1);
-            for (o, &v) in out_row.iter_mut().zip(&plane[source * width..(source + 1) * width]) {
-                *o += tap * v;
+impl Band {
+    /// Each row of `plane` (the rows `read`) filtered by `taps`, the row's end values repeated
+    /// past its ends.
+    fn horizontal(&self, plane: &[f32], taps: &[f32]) -> Vec<f32> {
+        let (width, radius) = (self.width, taps.len() / 2);
+        let mut out = vec![0.0f32; plane.len()];
+        let mut padded = vec![0.0f32; width + 2 * radius];
+        for (row, out_row) in plane.chunks_exact(width).zip(out.chunks_exact_mut(width)) {
+            for (i, p) in padded.iter_mut().enumerate() {
+                *p = row[i.saturating_sub(radius).min(width - 1)];
+            }
+            for (t, &tap) in taps.iter().enumerate() {
+                for (o, &v) in out_row.iter_mut().zip(&padded[t..t + width]) {
+                    *o += tap * v;
+                }
             }
         }
+        out
     }
-    out
+
+    /// The band's rows of `plane` (the rows `read`) filtered down the columns by `taps`, the
+    /// picture's first and last rows repeated past its ends.
+    fn vertical(&self, plane: &[f32], taps: &[f32]) -> Vec<f32> {
+        let (width, radius) = (self.width, taps.len() / 2);
+        let mut out = vec![0.0f32; self.rows.len() * width];
+        for (y, out_row) in self.rows.clone().zip(out.chunks_exact_mut(width)) {
+            for (t, &tap) in taps.iter().enumerate() {
+                let source = (y + t).saturating_sub(radius).min(self.height - 1) - self.read.start;
+                for (o, &v) in out_row.iter_mut().zip(&plane[source * width..(source + 1) * width]) {
+                    *o += tap * v;
+                }
+            }
+        }
+        out
+    }
 }

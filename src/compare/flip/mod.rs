@@ -21,58 +21,67 @@ use std::sync::OnceLock;
 
 use image::RgbImage;
 
-pub(super) use maps::Maps;
+use maps::Maps;
+pub(super) use maps::Reference;
 
-/// Below this fraction of differing pixels (1 in `SPARSE_BELOW`), spreading each difference
-/// through the kernels costs less than filtering the whole test picture: a differing pixel
-/// costs about 3,200 multiply-adds there, a pixel about 300 here.
+/// Below this fraction of differing pixels (1 in `SPARSE_BELOW`) of the rows that differ,
+/// spreading each difference through the kernels costs less than filtering those rows of the
+/// test picture: a differing pixel costs about 3,200 multiply-adds there, a pixel about 300 here.
 const SPARSE_BELOW: usize = 12;
 
 /// The mean of FLIP's per-pixel error map, in [0, 1], at FLIP's default viewing setup (0.7 m from
-/// a 24-inch 4K monitor). `reference` holds the expected picture's maps once made; they are made
-/// only when the pictures differ. The pictures must have the same size, which `compare` checks
-/// before measuring anything.
-pub(super) fn flip_mean(expected: &RgbImage, reference: &OnceLock<Maps>, actual: &RgbImage) -> f64 {
-    let pixels = expected.width() as usize * expected.height() as usize;
-    if pixels == 0 {
+/// a 24-inch 4K monitor). `reference` holds what FLIP keeps of the expected picture once made;
+/// it is made only when the pictures differ. The pictures must have the same size, which
+/// `compare` checks before measuring anything.
+pub(super) fn flip_mean(expected: &RgbImage, reference: &OnceLock<Reference>, actual: &RgbImage) -> f64 {
+    let (width, height) = (expected.width() as usize, expected.height() as usize);
+    if width * height == 0 {
         return 0.0;
     }
+    let row_bytes = width * 3;
     let differing: Vec<usize> = expected
         .as_raw()
-        .chunks_exact(3)
-        .zip(actual.as_raw().chunks_exact(3))
+        .chunks_exact(row_bytes)
+        .zip(actual.as_raw().chunks_exact(row_bytes))
         .enumerate()
         .filter(|(_, (e, a))| e != a)
-        .map(|(i, _)| i)
+        .flat_map(|(y, (e, a))| {
+            e.chunks_exact(3)
+                .zip(a.chunks_exact(3))
+                .enumerate()
+                .filter(|(_, (p, q))| p != q)
+                .map(move |(x, _)| y * width + x)
+        })
         .collect();
-    if differing.is_empty() {
+    let (Some(&first), Some(&last)) = (differing.first(), differing.last()) else {
         return 0.0;
-    }
-    let maps = reference.get_or_init(|| Maps::of(expected));
-    let sum = if differing.len() * SPARSE_BELOW < pixels {
-        sparse::error_sum(expected, maps, actual, &differing)
-    } else {
-        dense_error_sum(maps, actual)
     };
-    sum / pixels as f64
+    let reference = reference.get_or_init(|| Reference::of(expected));
+    // The rows whose maps a difference can reach.
+    let reach = kernels::KERNELS.spatial_radius().max(kernels::KERNELS.feature_radius());
+    let rows = (first / width).saturating_sub(reach)..(last / width + reach + 1).min(height);
+    let sum = if differing.len() * SPARSE_BELOW < rows.len() * width {
+        sparse::error_sum(expected, reference, actual, &differing)
+    } else {
+        dense_error_sum(reference, &Maps::of(actual, rows))
+    };
+    sum / (width * height) as f64
 }
 
-/// The sum of FLIP's error map of `test` against the reference whose maps are `reference`, with
-/// the test picture filtered whole. Pixels whose maps agree exactly have no error.
-fn dense_error_sum(reference: &Maps, test: &RgbImage) -> f64 {
-    let tested = Maps::of(test);
-    let pixels = test.width() as usize * test.height() as usize;
-    (0..pixels)
+/// The sum of FLIP's error map of a test picture whose maps are `test` (over the rows where it
+/// differs) against `reference`. Pixels whose maps agree exactly have no error.
+fn dense_error_sum(reference: &Reference, test: &Maps) -> f64 {
+    test.pixels()
         .map(|p| {
-            let (color, features) = (reference.color(p), reference.features(p));
-            let (test_color, test_features) = (tested.color(p), tested.features(p));
-            if color == test_color && features == test_features {
+            let (color, features) = (test.color(p), test.features(p));
+            if color == reference.maps.color(p) && features == reference.maps.features(p) {
                 return 0.0;
             }
+            let color_error = color::color_error(reference.perceived[p], color::perceived(color));
             f64::from(color::flip_error(
-                color::color_error(color, test_color),
-                features,
-                test_features,
+                color_error,
+                reference.strengths[p],
+                color::strengths(features),
             ))
         })
         .sum()
@@ -197,12 +206,15 @@ mod tests {
             let pixel = actual.get_pixel_mut(i % 200, 60 + i / 200);
             pixel.0 = pixel.0.map(|c| c.saturating_sub(6));
         }
-        let maps = Maps::of(&expected);
+        let reference = Reference::of(&expected);
         let differing: Vec<usize> = (0..200 * 150)
             .filter(|&i| expected.as_raw()[3 * i..3 * i + 3] != actual.as_raw()[3 * i..3 * i + 3])
             .collect();
-        let sparse = sparse::error_sum(&expected, &maps, &actual, &differing);
-        let dense = dense_error_sum(&maps, &actual);
+        let sparse = sparse::error_sum(&expected, &reference, &actual, &differing);
+        let dense = dense_error_sum(&reference, &Maps::of(&actual, 0..150));
+        // Only the rows a difference reaches are filtered, with the same result.
+        let band = dense_error_sum(&reference, &Maps::of(&actual, 50..111));
+        assert_eq!(band, dense);
         assert!(dense > 0.0);
         assert!((sparse - dense).abs() <= 1e-5 * dense, "sparse {sparse}, dense {dense}");
     }

@@ -5,28 +5,25 @@
 
 use image::RgbImage;
 
-use super::color::{color_error, feature_input, flip_error, srgb_to_ycxcz};
+use super::color::{color_error, feature_input, flip_error, perceived, srgb_to_ycxcz, strengths};
 use super::kernels::{KERNELS, clamped_weight};
-use super::maps::Maps;
+use super::maps::Reference;
 
 /// The longest kernel, in taps (the spatial filters have 21 at the default viewing setup).
 const MAX_TAPS: usize = 32;
 
-/// The sum of FLIP's error map of `test` against `reference` (whose maps are `maps`), which
-/// differ only at the pixel indices `differing` (ascending).
-pub(super) fn error_sum(reference: &RgbImage, maps: &Maps, test: &RgbImage, differing: &[usize]) -> f64 {
+/// The sum of FLIP's error map of `test` against `reference` (`picture`'s maps), which differ
+/// only at the pixel indices `differing`.
+pub(super) fn error_sum(picture: &RgbImage, reference: &Reference, test: &RgbImage, differing: &[usize]) -> f64 {
     let k = &*KERNELS;
-    let (width, height) = (reference.width() as usize, reference.height() as usize);
-    let pixels = width * height;
-    let mut color: [Vec<f32>; 3] = std::array::from_fn(|_| vec![0.0; pixels]);
-    let mut features: [Vec<f32>; 4] = std::array::from_fn(|_| vec![0.0; pixels]);
-    let mut reached = vec![false; pixels];
+    let (width, height) = (picture.width() as usize, picture.height() as usize);
+    let mut changes = Changes::new(width * height);
     let (spatial, feature) = (k.spatial_radius(), k.feature_radius());
     assert!(k.achromatic.len() <= MAX_TAPS && k.gaussian.len() <= MAX_TAPS);
     for &pixel in differing {
         let (x, y) = (pixel % width, pixel / width);
         let at = |picture: &RgbImage| picture.get_pixel(x as u32, y as u32).0;
-        let (before, after) = (srgb_to_ycxcz(at(reference)), srgb_to_ycxcz(at(test)));
+        let (before, after) = (srgb_to_ycxcz(at(picture)), srgb_to_ycxcz(at(test)));
         let delta = [0, 1, 2].map(|c| after[c] - before[c]);
         let gray = feature_input(after[0]) - feature_input(before[0]);
 
@@ -37,13 +34,11 @@ pub(super) fn error_sum(reference: &RgbImage, maps: &Maps, test: &RgbImage, diff
         let [ay, ry, by1, by2] =
             [&k.achromatic, &k.red_green, &k.blue_yellow[0], &k.blue_yellow[1]].map(|t| ys.weights(t));
         for (j, ty) in ys.targets().enumerate() {
-            let row = ty * width;
             for (i, tx) in xs.targets().enumerate() {
-                let p = row + tx;
-                reached[p] = true;
-                color[0][p] += ay[j] * ax[i] * delta[0];
-                color[1][p] += ry[j] * rx[i] * delta[1];
-                color[2][p] += (by1[j] * bx1[i] + by2[j] * bx2[i]) * delta[2];
+                let change = changes.at(ty * width + tx);
+                change[0] += ay[j] * ax[i] * delta[0];
+                change[1] += ry[j] * rx[i] * delta[1];
+                change[2] += (by1[j] * bx1[i] + by2[j] * bx2[i]) * delta[2];
             }
         }
 
@@ -52,28 +47,55 @@ pub(super) fn error_sum(reference: &RgbImage, maps: &Maps, test: &RgbImage, diff
         let [gx, dx, ddx] = [&k.gaussian, &k.first, &k.second].map(|t| xs.weights(t));
         let [gy, dy, ddy] = [&k.gaussian, &k.first, &k.second].map(|t| ys.weights(t));
         for (j, ty) in ys.targets().enumerate() {
-            let row = ty * width;
             for (i, tx) in xs.targets().enumerate() {
-                let p = row + tx;
-                reached[p] = true;
-                features[0][p] += gy[j] * dx[i] * gray;
-                features[1][p] += dy[j] * gx[i] * gray;
-                features[2][p] += gy[j] * ddx[i] * gray;
-                features[3][p] += ddy[j] * gx[i] * gray;
+                let change = changes.at(ty * width + tx);
+                change[3] += gy[j] * dx[i] * gray;
+                change[4] += dy[j] * gx[i] * gray;
+                change[5] += gy[j] * ddx[i] * gray;
+                change[6] += ddy[j] * gx[i] * gray;
             }
         }
     }
-    reached
+    changes
+        .reached
         .iter()
-        .enumerate()
-        .filter(|&(_, &r)| r)
-        .map(|(p, _)| {
-            let (before, features_before) = (maps.color(p), maps.features(p));
-            let after = [0, 1, 2].map(|c| before[c] + color[c][p]);
-            let features_after = [0, 1, 2, 3].map(|c| features_before[c] + features[c][p]);
-            f64::from(flip_error(color_error(before, after), features_before, features_after))
+        .zip(&changes.sums)
+        .map(|(&p, change)| {
+            let (color, features) = (reference.maps.color(p), reference.maps.features(p));
+            let color = [0, 1, 2].map(|c| color[c] + change[c]);
+            let features = [0, 1, 2, 3].map(|c| features[c] + change[3 + c]);
+            let color_error = color_error(reference.perceived[p], perceived(color));
+            f64::from(flip_error(color_error, reference.strengths[p], strengths(features)))
         })
         .sum()
+}
+
+/// The changes to the maps (colour, then features) at the pixels the differences reach, in the
+/// order first reached; a pixel's slot is found through one index per pixel.
+struct Changes {
+    slot: Vec<u32>,
+    reached: Vec<usize>,
+    sums: Vec<[f32; 7]>,
+}
+
+impl Changes {
+    fn new(pixels: usize) -> Changes {
+        Changes {
+            slot: vec![u32::MAX; pixels],
+            reached: Vec::new(),
+            sums: Vec::new(),
+        }
+    }
+
+    fn at(&mut self, pixel: usize) -> &mut [f32; 7] {
+        let slot = &mut self.slot[pixel];
+        if *slot == u32::MAX {
+            *slot = self.sums.len() as u32;
+            self.reached.push(pixel);
+            self.sums.push([0.0; 7]);
+        }
+        &mut self.sums[*slot as usize]
+    }
 }
 
 /// The pixels along one axis that a source pixel's kernels reach.
