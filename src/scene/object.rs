@@ -236,7 +236,7 @@ mod tests {
                 assert!(close(surface.point, reference.point, 1e-5), "{surface:?} vs {reference:?}");
                 assert!(close(surface.geometric_normal, reference.geometric_normal, 1e-5), "{surface:?} vs {reference:?}");
                 assert!(close(surface.shading_normal, reference.shading_normal, 1e-5), "{surface:?} vs {reference:?}");
-                assert_eq!(placed.occluded(&ray, expected.t() * 1.01), true);
+                assert!(placed.occluded(&ray, expected.t() * 1.01));
             }
         }
     }
