@@ -1,7 +1,9 @@
 //! Triangle meshes with their own BVH, built once and shared (behind an `Arc`) by every
 //! instance that places the mesh in a scene.
 
+mod flat;
 mod leaf_tests;
+mod placed;
 
 use std::time::{Duration, Instant};
 
@@ -15,6 +17,7 @@ use super::triangle::{
 use super::{Ray, SurfaceHit};
 use super::real::{Real, Vec3};
 pub use crate::build_error::MeshError;
+use flat::FlatLeaves;
 use leaf_tests::{AnyTriangle, NearestTriangle, NearestTriangles};
 use crate::simd::{Isa, Kernel, dispatch};
 use rayon::prelude::*;
@@ -67,6 +70,8 @@ pub struct Mesh {
     packs: Vec<TrianglePack>,
     /// Its leaves are runs of `packs`.
     bvh: Bvh,
+    /// For a small mesh, its leaves behind one box test, which rays take instead of the tree.
+    flat: Option<FlatLeaves>,
     /// Kept for render statistics, which report BVH builds apart from OBJ parsing.
     bvh_build_time: Duration,
 }
@@ -100,6 +105,7 @@ impl Mesh {
         let (mut bvh, order) = Bvh::build_for(&bounds, LeafCost::PerPackOfFour).into_leaf_order();
         drop(bounds);
         let corners: Vec<[Vec3; 3]> = order.par_iter().map(|&i| corners_of(triangles[i as usize])).collect();
+        let flat = FlatLeaves::new(&bvh.leaves(), &corners);
         let packs = pack_leaves(&mut bvh, &corners);
         let bvh_build_time = build_start.elapsed();
         Ok(Mesh {
@@ -108,6 +114,7 @@ impl Mesh {
             normals,
             packs,
             bvh,
+            flat,
             bvh_build_time,
         })
     }
@@ -126,10 +133,21 @@ impl Mesh {
         dispatch(Closest(self, ray, t_max))
     }
 
+    /// [`Mesh::intersect`] inside a caller's kernel (see `crate::simd`), which saves a second
+    /// dispatch when a scene's query reaches the mesh.
     #[inline(always)]
-    fn closest_lanes<I: Isa>(&self, ray: &Ray, t_max: Real) -> Option<MeshHit> {
+    pub fn closest_lanes<I: Isa>(&self, ray: &Ray, t_max: Real) -> Option<MeshHit> {
+        let Some(flat) = &self.flat else {
+            let mut nearest = NearestTriangle { mesh: self, ray: PackRay::<I>::new(ray), closest: None };
+            traverse::<I>(self.bvh.nodes(), ray, t_max, &mut nearest);
+            return nearest.closest;
+        };
+        let (hits, t) = flat.entered::<I>(ray, t_max);
+        if hits == 0 {
+            return None;
+        }
         let mut nearest = NearestTriangle { mesh: self, ray: PackRay::<I>::new(ray), closest: None };
-        traverse::<I>(self.bvh.nodes(), ray, t_max, &mut nearest);
+        flat.visit::<I>(hits, &t, t_max, &mut nearest);
         nearest.closest
     }
 
@@ -183,10 +201,20 @@ impl Mesh {
         dispatch(Any(self, ray, t_max))
     }
 
+    /// [`Mesh::occluded`] inside a caller's kernel (see `crate::simd`).
     #[inline(always)]
-    fn any_lanes<I: Isa>(&self, ray: &Ray, t_max: Real) -> bool {
+    pub fn any_lanes<I: Isa>(&self, ray: &Ray, t_max: Real) -> bool {
+        let Some(flat) = &self.flat else {
+            let mut blocker = AnyTriangle { mesh: self, ray: PackRay::<I>::new(ray), found: false };
+            traverse::<I>(self.bvh.nodes(), ray, t_max, &mut blocker);
+            return blocker.found;
+        };
+        let (hits, t) = flat.entered::<I>(ray, t_max);
+        if hits == 0 {
+            return false;
+        }
         let mut blocker = AnyTriangle { mesh: self, ray: PackRay::<I>::new(ray), found: false };
-        traverse::<I>(self.bvh.nodes(), ray, t_max, &mut blocker);
+        flat.visit::<I>(hits, &t, t_max, &mut blocker);
         blocker.found
     }
 

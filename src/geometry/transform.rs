@@ -83,6 +83,19 @@ impl Transform {
         self.object_to_world.transform_vector3(vector)
     }
 
+    /// The normal mapped by the inverse transpose, not normalised: normals mapped so keep
+    /// their barycentric interpolation the image of the object-space one (for meshes placed in
+    /// world space, see `Mesh::from_placed`).
+    pub fn normal_to_world_unnormalised(&self, normal: Vec3) -> Vec3 {
+        self.normal_to_world * normal
+    }
+
+    /// Whether the transform mirrors (its linear part has a negative determinant): triangles
+    /// moved by it reverse their winding.
+    pub fn mirrors(&self) -> bool {
+        Mat3::from_mat4(self.object_to_world).determinant() < 0.0
+    }
+
     /// Unit world normal; a normal that degenerates (it cannot for a non-singular transform,
     /// but rounding is rounding) keeps the object-space direction rather than becoming NaN.
     pub fn normal_to_world(&self, normal: Vec3) -> Vec3 {

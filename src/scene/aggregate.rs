@@ -18,6 +18,9 @@ const SPHERE_PACK_LIMIT: usize = SPHERE_LANES;
 pub struct Aggregate {
     /// In the scene's order, which is also the order that breaks ties (see [`Aggregate::intersect`]).
     objects: Vec<Object>,
+    /// What rays are traced against: `objects`, but with small instanced meshes placed in world
+    /// space ([`Object::placed`]).
+    traced: Vec<Object>,
     planes: Vec<(Plane, u32)>,
     /// The planes side by side, in order.
     plane_packs: Vec<PlanePack>,
@@ -74,6 +77,7 @@ impl Closest {
 
 impl Aggregate {
     pub fn new(objects: Vec<Object>, planes: Vec<(Plane, u32)>) -> Aggregate {
+        let traced: Vec<Object> = objects.iter().map(|object| object.placed().unwrap_or_else(|| object.clone())).collect();
         let plain_spheres: Vec<(u32, _)> = objects
             .iter()
             .enumerate()
@@ -93,15 +97,15 @@ impl Aggregate {
         let rest = match others.as_slice() {
             [] => Rest::Nothing,
             &[object] => {
-                let lone = &objects[object as usize];
+                let lone = &traced[object as usize];
                 Rest::One { object, bounds: lone.transform.is_some().then(|| lone.bounds()) }
             }
             few if few.len() <= WIDTH => {
-                let bounds: Vec<Aabb> = few.iter().map(|&index| objects[index as usize].bounds()).collect();
+                let bounds: Vec<Aabb> = few.iter().map(|&index| traced[index as usize].bounds()).collect();
                 Rest::Few { boxes: Box::new(BoxSet::new(&bounds)), objects: others }
             }
             _ => {
-                let bounds: Vec<Aabb> = others.iter().map(|&index| objects[index as usize].bounds()).collect();
+                let bounds: Vec<Aabb> = others.iter().map(|&index| traced[index as usize].bounds()).collect();
                 let bvh = Bvh::build_for(&bounds, LeafCost::Single);
                 let in_leaf_order = bvh.prim_indices().iter().map(|&k| others[k as usize]).collect();
                 Rest::Tree { bvh, objects: in_leaf_order }
@@ -109,7 +113,7 @@ impl Aggregate {
         };
         let plane_list: Vec<Plane> = planes.iter().map(|(plane, _)| *plane).collect();
         let plane_packs = plane_list.chunks(PLANE_LANES).map(PlanePack::new).collect();
-        Aggregate { objects, planes, plane_packs, spheres, rest }
+        Aggregate { objects, traced, planes, plane_packs, spheres, rest }
     }
 
     pub fn objects(&self) -> &[Object] {
@@ -143,7 +147,7 @@ impl Aggregate {
         }
         Some(match dispatch(Nearest(self, ray))? {
             Found::Object(index, hit) => {
-                let object = &self.objects[index as usize];
+                let object = &self.traced[index as usize];
                 Intersection { surface: object.surface(ray, &hit), material: object.material }
             }
             Found::Plane(index, t) => {
@@ -190,7 +194,7 @@ impl Aggregate {
             Rest::Nothing => {}
             Rest::One { object, bounds } => {
                 if bounds.is_none_or(|bounds| bounds.hit_by(&SlabRay::new(ray), closest.t))
-                    && let Some(hit) = self.objects[*object as usize].intersect(ray, closest.t)
+                    && let Some(hit) = self.traced[*object as usize].intersect_lanes::<I>(ray, closest.t)
                 {
                     closest.offer(hit.t(), *object, Found::Object(*object, hit));
                 }
@@ -205,7 +209,7 @@ impl Aggregate {
                             break;
                         }
                         let index = objects[lane];
-                        if let Some(hit) = self.objects[index as usize].intersect(ray, closest.t) {
+                        if let Some(hit) = self.traced[index as usize].intersect_lanes::<I>(ray, closest.t) {
                             closest.offer(hit.t(), index, Found::Object(index, hit));
                         }
                     }
@@ -214,7 +218,7 @@ impl Aggregate {
             Rest::Tree { bvh, objects } => {
                 traverse::<I>(bvh.nodes(), ray, closest.t, &mut VisitFn(|first: u32, count: u32, t_limit: &mut Real| {
                     for &index in &objects[first as usize..(first + count) as usize] {
-                        if let Some(hit) = self.objects[index as usize].intersect(ray, *t_limit) {
+                        if let Some(hit) = self.traced[index as usize].intersect_lanes::<I>(ray, *t_limit) {
                             closest.offer(hit.t(), index, Found::Object(index, hit));
                             *t_limit = closest.t;
                         }
@@ -254,14 +258,14 @@ impl Aggregate {
             Rest::Nothing => false,
             Rest::One { object, bounds } => {
                 bounds.is_none_or(|bounds| bounds.hit_by(&SlabRay::new(ray), t_max))
-                    && self.objects[*object as usize].occluded(ray, t_max)
+                    && self.traced[*object as usize].occluded_lanes::<I>(ray, t_max)
             }
             Rest::Few { boxes, objects } => {
                 let (mut hits, _) = boxes.entered::<I>(ray, t_max);
                 while hits != 0 {
                     let lane = hits.trailing_zeros() as usize;
                     hits &= hits - 1;
-                    if self.objects[objects[lane] as usize].occluded(ray, t_max) {
+                    if self.traced[objects[lane] as usize].occluded_lanes::<I>(ray, t_max) {
                         return true;
                     }
                 }
@@ -271,7 +275,7 @@ impl Aggregate {
                 let mut blocked = false;
                 traverse::<I>(bvh.nodes(), ray, t_max, &mut VisitFn(|first: u32, count: u32, t_limit: &mut Real| {
                     let leaf = &objects[first as usize..(first + count) as usize];
-                    if leaf.iter().any(|&index| self.objects[index as usize].occluded(ray, *t_limit)) {
+                    if leaf.iter().any(|&index| self.traced[index as usize].occluded_lanes::<I>(ray, *t_limit)) {
                         blocked = true;
                         Visit::Stop
                     } else {

@@ -38,7 +38,9 @@ impl Material {
         if !self.reflects() && cos_view <= 1.0 {
             return diffuse * intensity;
         }
-        let highlight = cos_view.powf(self.shininess);
+        // `powf(x, 1)` is `x` exactly; the course's scenes use shininess 1 for their floors,
+        // and the call costs a sampled render of such a scene about 2% of its instructions.
+        let highlight = if self.shininess == 1.0 { cos_view } else { cos_view.powf(self.shininess) };
         (diffuse + highlight * self.specular) * intensity
     }
 }

@@ -9,6 +9,7 @@ use super::geometry::transform::Transform;
 use super::geometry::triangle::{TriangleHit, TriangleRay, intersect_triangle, triangle_surface};
 use super::geometry::{Ray, SurfaceHit};
 use super::real::{Real, Vec3};
+use crate::simd::{Isa, Kernel, dispatch};
 
 #[derive(Clone, Debug)]
 pub struct Triangle {
@@ -62,7 +63,51 @@ impl ShapeHit {
     }
 }
 
+/// Instanced meshes of up to this many triangles are traced placed in world space (see
+/// [`Object::placed`]): a copy of a few dozen triangles per instance costs nothing, and the ray
+/// is then neither moved into the instance's space nor its hit moved back.
+const PLACED_MESH_LIMIT: usize = 64;
+
 impl Object {
+    /// The same object with its mesh moved into world space, when it is an instance of a mesh of
+    /// at most `PLACED_MESH_LIMIT` triangles (and every moved corner and normal is finite).
+    ///
+    /// Placing rounds each corner once, at build time, where instancing rounds each ray into
+    /// the instance's space and its hit back, so hit points and normals differ from
+    /// instancing's by rounding only. The vertex normals are mapped by the inverse transpose
+    /// without normalising, so that they interpolate to the direction the instance shades
+    /// with; a mirroring transform swaps two corners, as for a lone triangle, so that the face
+    /// normal stays the inverse transpose's.
+    pub fn placed(&self) -> Option<Object> {
+        let (Shape::Mesh(mesh), Some(transform)) = (&self.shape, &self.transform) else {
+            return None;
+        };
+        if mesh.triangle_count() > PLACED_MESH_LIMIT {
+            return None;
+        }
+        let finite = |vectors: &[Vec3; 3]| vectors.iter().all(|v| v.is_finite());
+        let mut corners = Vec::with_capacity(mesh.triangle_count());
+        let mut normals = Vec::with_capacity(mesh.triangle_count());
+        for triangle in 0..mesh.triangle_count() as u32 {
+            let mut placed = mesh.triangle(triangle).map(|p| transform.point_to_world(p));
+            let mut vertex_normals =
+                mesh.vertex_normals(triangle).map(|ns| ns.map(|n| transform.normal_to_world_unnormalised(n)));
+            if transform.mirrors() {
+                placed.swap(1, 2);
+                if let Some(ns) = &mut vertex_normals {
+                    ns.swap(1, 2);
+                }
+            }
+            if !finite(&placed) || !vertex_normals.as_ref().is_none_or(finite) {
+                return None;
+            }
+            corners.push(placed);
+            normals.push(vertex_normals);
+        }
+        let placed = Mesh::from_placed(&corners, &normals);
+        Some(Object { shape: Shape::Mesh(Arc::new(placed)), transform: None, material: self.material })
+    }
+
     pub fn bounds(&self) -> Aabb {
         let local = match &self.shape {
             Shape::Sphere(sphere) => sphere.bounds(),
@@ -86,6 +131,21 @@ impl Object {
 
     /// The closest hit before `t_max`, with `t` in the world ray's parameter.
     pub fn intersect(&self, world_ray: &Ray, t_max: Real) -> Option<ShapeHit> {
+        struct Closest<'a>(&'a Object, &'a Ray, Real);
+        impl Kernel for Closest<'_> {
+            type Output = Option<ShapeHit>;
+            #[inline(always)]
+            fn run<I: Isa>(self) -> Option<ShapeHit> {
+                self.0.intersect_lanes::<I>(self.1, self.2)
+            }
+        }
+        dispatch(Closest(self, world_ray, t_max))
+    }
+
+    /// [`Object::intersect`] inside a caller's kernel (see `crate::simd`): a mesh is traversed
+    /// without a second dispatch.
+    #[inline(always)]
+    pub fn intersect_lanes<I: Isa>(&self, world_ray: &Ray, t_max: Real) -> Option<ShapeHit> {
         let (ray, shift) = self.local_ray(world_ray);
         let t_max = t_max - shift;
         let hit = match &self.shape {
@@ -94,18 +154,32 @@ impl Object {
                 let [p0, p1, p2] = triangle.vertices;
                 intersect_triangle(&TriangleRay::new(&ray), t_max, p0, p1, p2).map(ShapeHit::Triangle)
             }
-            Shape::Mesh(mesh) => mesh.intersect(&ray, t_max).map(ShapeHit::Mesh),
+            Shape::Mesh(mesh) => mesh.closest_lanes::<I>(&ray, t_max).map(ShapeHit::Mesh),
         }?;
         Some(hit.shifted(shift))
     }
 
     pub fn occluded(&self, world_ray: &Ray, t_max: Real) -> bool {
+        struct Any<'a>(&'a Object, &'a Ray, Real);
+        impl Kernel for Any<'_> {
+            type Output = bool;
+            #[inline(always)]
+            fn run<I: Isa>(self) -> bool {
+                self.0.occluded_lanes::<I>(self.1, self.2)
+            }
+        }
+        dispatch(Any(self, world_ray, t_max))
+    }
+
+    /// [`Object::occluded`] inside a caller's kernel.
+    #[inline(always)]
+    pub fn occluded_lanes<I: Isa>(&self, world_ray: &Ray, t_max: Real) -> bool {
         match &self.shape {
             Shape::Mesh(mesh) => {
                 let (ray, shift) = self.local_ray(world_ray);
-                mesh.occluded(&ray, t_max - shift)
+                mesh.any_lanes::<I>(&ray, t_max - shift)
             }
-            _ => self.intersect(world_ray, t_max).is_some(),
+            _ => self.intersect_lanes::<I>(world_ray, t_max).is_some(),
         }
     }
 
@@ -125,5 +199,57 @@ impl Object {
             Some(transform) => SurfaceHit { t: hit.t(), ..transform.hit_to_world(&surface) },
             None => surface,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use super::super::geometry::generate::blob;
+    use super::super::geometry::mesh::VertexNormals;
+    use super::super::real::Mat4;
+
+    /// A small instanced mesh placed in world space is hit where the instance is, up to
+    /// rounding, and shades with the same normals, also under a non-uniform, mirroring transform.
+    #[test]
+    fn a_placed_mesh_is_hit_and_shaded_as_its_instance() {
+        let (positions, triangles) = blob(0, 5);
+        let mesh = Arc::new(Mesh::new(&positions, &triangles, VertexNormals::Averaged).unwrap());
+        let matrix = Mat4::from_translation(Vec3::new(1.0, -2.0, 0.5))
+            * Mat4::from_rotation_y(0.7)
+            * Mat4::from_scale(Vec3::new(-1.5, 0.25, 2.0));
+        let instance =
+            Object { shape: Shape::Mesh(mesh.clone()), transform: Some(Arc::new(Transform::new(matrix).unwrap())), material: 3 };
+        let placed = instance.placed().expect("20 triangles are placed");
+        assert!(placed.transform.is_none());
+        assert_eq!(placed.material, 3);
+        let close = |a: Vec3, b: Vec3, tolerance: Real| (a - b).length() <= tolerance * (1.0 + a.length());
+        for triangle in 0..mesh.triangle_count() as u32 {
+            let [p0, p1, p2] = mesh.triangle(triangle);
+            let target = matrix.transform_point3((p0 + p1 + p2) / 3.0);
+            for origin in [Vec3::new(9.0, 4.0, -7.0), Vec3::new(-8.0, -6.0, 5.0), Vec3::new(0.5, 9.0, 0.0)] {
+                let ray = Ray::new(origin, target - origin);
+                let expected = instance.intersect(&ray, Real::INFINITY).expect("aimed at a triangle");
+                let hit = placed.intersect(&ray, Real::INFINITY).expect("the placed mesh is hit too");
+                assert!((hit.t() - expected.t()).abs() <= 1e-5 * expected.t(), "{triangle}: {hit:?} vs {expected:?}");
+                let (surface, reference) = (placed.surface(&ray, &hit), instance.surface(&ray, &expected));
+                assert!(close(surface.point, reference.point, 1e-5), "{surface:?} vs {reference:?}");
+                assert!(close(surface.geometric_normal, reference.geometric_normal, 1e-5), "{surface:?} vs {reference:?}");
+                assert!(close(surface.shading_normal, reference.shading_normal, 1e-5), "{surface:?} vs {reference:?}");
+                assert!(placed.occluded(&ray, expected.t() * 1.01));
+            }
+        }
+    }
+
+    #[test]
+    fn large_or_untransformed_meshes_stay_as_they_are() {
+        let (positions, triangles) = blob(1, 5);
+        let large = Arc::new(Mesh::new(&positions, &triangles, VertexNormals::Averaged).unwrap());
+        let scale = Some(Arc::new(Transform::new(Mat4::from_scale(Vec3::splat(2.0))).unwrap()));
+        assert!(Object { shape: Shape::Mesh(large), transform: scale.clone(), material: 0 }.placed().is_none());
+        let (positions, triangles) = blob(0, 5);
+        let small = Arc::new(Mesh::new(&positions, &triangles, VertexNormals::Averaged).unwrap());
+        assert!(Object { shape: Shape::Mesh(small.clone()), transform: None, material: 0 }.placed().is_none());
+        assert!(Object { shape: Shape::Mesh(small), transform: scale, material: 0 }.placed().is_some());
     }
 }

@@ -91,6 +91,16 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(12))]
+    /// Meshes of up to sixteen packs skip their tree (one box test over runs of leaves): the
+    /// same hits, ties included.
+    #[test]
+    fn small_meshes_tested_without_their_tree_agree_too(seed in any::<u64>(), count in 4usize..40) {
+        check(seed, count);
+    }
+}
+
 #[test]
 fn of_coinciding_triangles_the_smaller_index_wins() {
     let positions = [
