@@ -16,7 +16,7 @@ use super::similarity::Fingerprint;
 use super::submission::{Folder, read_png};
 use super::timing::{Timings, seconds, timed};
 use crate::atomic_write::replace_file;
-use crate::compare::{Image, Metrics, Tolerance, compare_timed, diff_heatmap, diff_heatmap_widened};
+use crate::compare::{Encoding, Image, Metrics, Tolerance, compare_timed, diff_heatmap, diff_heatmap_widened};
 use crate::film::{OutputError, encode_png};
 
 /// One expected file of one student.
@@ -188,8 +188,16 @@ pub fn grade_image(
         max: None,
     };
     let compare_started = Instant::now();
-    let actual = Image::from_rgb8(picture.clone(), located.path);
-    let (comparison, flip) = compare_timed(golden, &actual, &tolerance, allowance);
+    // A picture identical to the golden one (most of a class's) is measured as the golden against
+    // itself: the same measurements, without making the picture's channel planes.
+    let submitted_image;
+    let actual = if golden.encoding == Encoding::Code8 && golden.preview == picture {
+        golden
+    } else {
+        submitted_image = Image::from_rgb8(picture, located.path);
+        &submitted_image
+    };
+    let (comparison, flip) = compare_timed(golden, actual, &tolerance, allowance);
     timings.compare += seconds(compare_started.elapsed().saturating_sub(flip));
     timings.flip += seconds(flip);
     let Some(metrics) = comparison.metrics else {
@@ -203,7 +211,7 @@ pub fn grade_image(
             actual: [actual.width, actual.height],
         };
         result.fingerprint =
-            (!copy_of_published).then(|| timed(&mut timings.decode, || Fingerprint::of(&picture, true)));
+            (!copy_of_published).then(|| timed(&mut timings.decode, || Fingerprint::of(&actual.preview, true)));
         return Ok(refused(result, outcome));
     };
     let (outcome, mut explanation) = judge(&spec.rule, &metrics);
@@ -221,8 +229,8 @@ pub fn grade_image(
         replace_file(&out.join(&copy), &encode_png(&actual.preview)?)?;
         result.student_image = Some(copy);
         let heatmap = match allowance {
-            Some(allowance) => diff_heatmap_widened(golden, &actual, spec.rule.threshold, allowance),
-            None => diff_heatmap(golden, &actual, spec.rule.threshold),
+            Some(allowance) => diff_heatmap_widened(golden, actual, spec.rule.threshold, allowance),
+            None => diff_heatmap(golden, actual, spec.rule.threshold),
         };
         if let Some(heatmap) = heatmap {
             let stem = spec.file.strip_suffix(".png").unwrap_or(&spec.file);
@@ -247,7 +255,7 @@ pub fn grade_image(
     // Matching the golden or the published answer is not copying a classmate.
     if metrics.worst.is_some() && !copy_of_published {
         result.fingerprint = Some(timed(&mut timings.decode, || {
-            Fingerprint::of(&picture, outcome != Outcome::Pass)
+            Fingerprint::of(&actual.preview, outcome != Outcome::Pass)
         }));
     }
     result.outcome = outcome;
