@@ -1,0 +1,54 @@
+#!/usr/bin/env bash
+# Times the course's seven grading commands at 800×800 (the commands of tests/data/mit6837/README.md),
+# each a separate `goldray mit6837` process, as a TA would run them. Prints the wall time of each
+# command and of all seven, for every binary given, alternating the binaries round by round so that
+# the shared machine's load falls on each alike.
+#
+#   scripts/time_course.sh [-n ROUNDS] [-o OUT_DIR] GOLDRAY_BINARY...
+#
+# Run from the project root (the scenes are read from cases/mit6837/). OUT_DIR defaults to a fresh
+# temporary folder; the PNGs left there can be compared between binaries with `cmp`.
+set -euo pipefail
+rounds=5
+out=""
+while getopts "n:o:" flag; do
+    case $flag in
+        n) rounds=$OPTARG ;;
+        o) out=$OPTARG ;;
+        *) echo "usage: $0 [-n ROUNDS] [-o OUT_DIR] GOLDRAY_BINARY..." >&2; exit 2 ;;
+    esac
+done
+shift $((OPTIND - 1))
+[ $# -ge 1 ] || { echo "usage: $0 [-n ROUNDS] [-o OUT_DIR] GOLDRAY_BINARY..." >&2; exit 2; }
+[ -n "$out" ] || out=$(mktemp -d)
+binaries=("$@")
+scenes=cases/mit6837
+# Scene number, scene file, depth range, further flags.
+commands=(
+    "01 scene01_plane 8 18"
+    "02 scene02_cube 8 18"
+    "03 scene03_sphere 8 18"
+    "04 scene04_axes 8 18"
+    "05 scene05_bunny_200 0.8 1.0"
+    "06 scene06_bunny_1k 8 18 -bounces 4"
+    "07 scene07_arch 8 18 -bounces 4 -shadows"
+)
+now() { date +%s.%N; }
+for round in $(seq "$rounds"); do
+    for binary in "${binaries[@]}"; do
+        dir="$out/$(basename "$binary")"
+        mkdir -p "$dir"
+        line=""
+        start=$(now)
+        for command in "${commands[@]}"; do
+            read -r n scene min max flags <<<"$command"
+            t0=$(now)
+            # shellcheck disable=SC2086 # the further flags are separate words
+            "$binary" mit6837 -size 800 800 -input "$scenes/$scene.txt" $flags -output "$dir/a$n.png" \
+                -normals "$dir/a${n}n.png" -depth "$min" "$max" "$dir/a${n}d.png" --quiet
+            line+=" a$n $(echo "$(now) - $t0" | bc | xargs printf '%.3f')"
+        done
+        total=$(echo "$(now) - $start" | bc | xargs printf '%.3f')
+        echo "round $round $(basename "$binary"): total $total s |$line"
+    done
+done
