@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Times the course's seven grading commands at 800×800 (the commands of tests/data/mit6837/README.md),
 # each a separate `goldray mit6837` process, as a TA would run them. Prints the wall time of each
-# command and of all seven, for every binary given, alternating the binaries round by round so that
-# the shared machine's load falls on each alike.
+# command and of all seven, and the processor time (user + system) the seven used, for every binary
+# given, alternating the binaries round by round so that the shared machine's load falls on each
+# alike. On a busy machine the wall times follow the load; the processor time much less so.
 #
 #   scripts/time_course.sh [-n ROUNDS] [-o OUT_DIR] GOLDRAY_BINARY...
 #
@@ -34,12 +35,20 @@ commands=(
     "07 scene07_arch 8 18 -bounces 4 -shadows"
 )
 now() { date +%s.%N; }
+# User plus system seconds of all finished child processes so far (the second line of bash's
+# `times`, which must run in this shell, not in a command substitution's subshell).
+children_cpu() {
+    times >"$out/.times"
+    tail -1 "$out/.times" | awk '{ gsub(/[ms]/, " "); print $1 * 60 + $2 + $3 * 60 + $4 }'
+}
 for round in $(seq "$rounds"); do
     for binary in "${binaries[@]}"; do
         dir="$out/$(basename "$binary")"
         mkdir -p "$dir"
         line=""
         start=$(now)
+        children_cpu >"$out/.cpu"
+        cpu=$(cat "$out/.cpu")
         for command in "${commands[@]}"; do
             read -r n scene min max flags <<<"$command"
             t0=$(now)
@@ -49,6 +58,8 @@ for round in $(seq "$rounds"); do
             line+=" a$n $(echo "$(now) - $t0" | bc | xargs printf '%.3f')"
         done
         total=$(echo "$(now) - $start" | bc | xargs printf '%.3f')
-        echo "round $round $(basename "$binary"): total $total s |$line"
+        children_cpu >"$out/.cpu"
+        used=$(echo "$(cat "$out/.cpu") - $cpu" | bc | xargs printf '%.3f')
+        echo "round $round $(basename "$binary"): total $total s, processor $used s |$line"
     done
 done

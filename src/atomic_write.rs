@@ -169,9 +169,11 @@ pub fn write_files_atomic(dir: &Path, files: &[(&Path, &[u8])]) -> Result<(), At
     }
 
     let mut installed: Vec<Installed> = Vec::with_capacity(files.len());
+    // Every target of a set keeps its old content until all are installed, the last one too
+    // (which is never rolled back), so that the old contents are freed side by side below rather
+    // than one by one inside the renames.
+    let needs_backup = files.len() > 1;
     for (i, (&(target, _), temp)) in files.iter().zip(&staged).enumerate() {
-        // The last target is never rolled back, so its old content needs no backup.
-        let needs_backup = i + 1 < files.len();
         let backup = staging.path().join(format!("{i}.previous"));
         let result =
             preserve(target, &backup, needs_backup).and_then(|previous| fs::rename(temp, target).map(|()| previous));
@@ -186,6 +188,19 @@ pub fn write_files_atomic(dir: &Path, files: &[(&Path, &[u8])]) -> Result<(), At
             }
         }
     }
+    // Freeing a replaced file can wait on the journal: about 4 ms each on ext4 mounted with
+    // `discard` (strace -T), most of a small render's writing. Unlinked side by side, a set of
+    // old contents costs about one such wait; the staging folder, then empty, goes on drop (which
+    // also removes whatever a failed unlink left).
+    let backups: Vec<PathBuf> = installed
+        .into_iter()
+        .filter_map(|installed| installed.previous)
+        .collect();
+    std::thread::scope(|scope| {
+        for backup in &backups {
+            scope.spawn(move || fs::remove_file(backup));
+        }
+    });
     Ok(())
 }
 
