@@ -5,24 +5,31 @@
 # given, alternating the binaries round by round so that the shared machine's load falls on each
 # alike. On a busy machine the wall times follow the load; the processor time much less so.
 #
-#   scripts/time_course.sh [-n ROUNDS] [-o OUT_DIR] GOLDRAY_BINARY...
+#   scripts/time_course.sh [-n ROUNDS] [-o OUT_DIR] [-c COURSE_BINARY] GOLDRAY_BINARY...
 #
 # Run from the project root (the scenes are read from cases/mit6837/). OUT_DIR defaults to a fresh
-# temporary folder; the PNGs left there can be compared between binaries with `cmp`.
+# temporary folder; the pictures left there can be compared between binaries. With -c, the course's
+# own renderer (`a2`) runs the same commands in each round too (from cases/mit6837/, where its scene
+# files find their meshes and cube map), for a ratio measured under the same load.
 set -euo pipefail
 rounds=5
 out=""
-while getopts "n:o:" flag; do
+course=""
+usage="usage: $0 [-n ROUNDS] [-o OUT_DIR] [-c COURSE_BINARY] GOLDRAY_BINARY..."
+while getopts "n:o:c:" flag; do
     case $flag in
         n) rounds=$OPTARG ;;
         o) out=$OPTARG ;;
-        *) echo "usage: $0 [-n ROUNDS] [-o OUT_DIR] GOLDRAY_BINARY..." >&2; exit 2 ;;
+        c) course=$(realpath "$OPTARG") ;;
+        *) echo "$usage" >&2; exit 2 ;;
     esac
 done
 shift $((OPTIND - 1))
-[ $# -ge 1 ] || { echo "usage: $0 [-n ROUNDS] [-o OUT_DIR] GOLDRAY_BINARY..." >&2; exit 2; }
+[ $# -ge 1 ] || { echo "$usage" >&2; exit 2; }
 [ -n "$out" ] || out=$(mktemp -d)
+out=$(realpath "$out")
 binaries=("$@")
+[ -z "$course" ] || binaries+=("$course")
 scenes=cases/mit6837
 # Scene number, scene file, depth range, further flags.
 commands=(
@@ -53,8 +60,13 @@ for round in $(seq "$rounds"); do
             read -r n scene min max flags <<<"$command"
             t0=$(now)
             # shellcheck disable=SC2086 # the further flags are separate words
-            "$binary" mit6837 -size 800 800 -input "$scenes/$scene.txt" $flags -output "$dir/a$n.png" \
-                -normals "$dir/a${n}n.png" -depth "$min" "$max" "$dir/a${n}d.png" --quiet
+            if [ "$binary" = "$course" ]; then
+                (cd "$scenes" && "$binary" -size 800 800 -input "$scene.txt" $flags -output "$dir/a$n.png" \
+                    -normals "$dir/a${n}n.png" -depth "$min" "$max" "$dir/a${n}d.png" >/dev/null)
+            else
+                "$binary" mit6837 -size 800 800 -input "$scenes/$scene.txt" $flags -output "$dir/a$n.png" \
+                    -normals "$dir/a${n}n.png" -depth "$min" "$max" "$dir/a${n}d.png" --quiet
+            fi
             line+=" a$n $(echo "$(now) - $t0" | bc | xargs printf '%.3f')"
         done
         total=$(echo "$(now) - $start" | bc | xargs printf '%.3f')
