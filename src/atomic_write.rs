@@ -145,22 +145,8 @@ pub fn write_files_atomic(dir: &Path, files: &[(&Path, &[u8])]) -> Result<(), At
     // whole and new. The syncs wait on the disk, not the processor, and are issued side by side
     // (a thread each) so that the file system commits them together: one after another, each
     // waits for its own journal commit, a few milliseconds apiece on a busy disk.
-    let stage = |(&(_, bytes), temp): (&(&Path, &[u8]), &PathBuf)| write_synced(temp, bytes);
-    let results: Vec<io::Result<()>> = if files.len() == 1 {
-        files.iter().zip(&staged).map(stage).collect()
-    } else {
-        std::thread::scope(|scope| {
-            let writers: Vec<_> = files
-                .iter()
-                .zip(&staged)
-                .map(|job| scope.spawn(move || stage(job)))
-                .collect();
-            writers
-                .into_iter()
-                .map(|writer| writer.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)))
-                .collect()
-        })
-    };
+    let jobs: Vec<(&[u8], &PathBuf)> = files.iter().map(|&(_, bytes)| bytes).zip(&staged).collect();
+    let results = side_by_side(&jobs, |&(bytes, temp)| write_synced(temp, bytes));
     for (&(target, _), result) in files.iter().zip(results) {
         result.map_err(|source| AtomicWriteError::Write {
             path: target.to_path_buf(),
@@ -196,12 +182,34 @@ pub fn write_files_atomic(dir: &Path, files: &[(&Path, &[u8])]) -> Result<(), At
         .into_iter()
         .filter_map(|installed| installed.previous)
         .collect();
-    std::thread::scope(|scope| {
-        for backup in &backups {
-            scope.spawn(move || fs::remove_file(backup));
-        }
-    });
+    side_by_side(&backups, |backup| fs::remove_file(backup));
     Ok(())
+}
+
+/// `job` of every item, in order, each on a thread of its own so that jobs waiting on the disk
+/// wait together: inline for a single item, and for any item the system refuses a thread for.
+fn side_by_side<T: Sync, R: Send>(items: &[T], job: impl Fn(&T) -> R + Sync) -> Vec<R> {
+    if items.len() < 2 {
+        return items.iter().map(job).collect();
+    }
+    std::thread::scope(|scope| {
+        let job = &job;
+        let running: Vec<_> = items
+            .iter()
+            .map(|item| {
+                std::thread::Builder::new()
+                    .spawn_scoped(scope, move || job(item))
+                    .map_err(|_| item)
+            })
+            .collect();
+        running
+            .into_iter()
+            .map(|thread| match thread {
+                Ok(thread) => thread.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)),
+                Err(item) => job(item),
+            })
+            .collect()
+    })
 }
 
 /// Keeps the current content of `target` at `backup` (when asked to and there is any), refusing a
@@ -295,6 +303,34 @@ mod tests {
             fs::read_dir(dir.path()).expect("list").count(),
             1,
             "a check leaves nothing behind"
+        );
+    }
+
+    #[test]
+    fn jobs_side_by_side_return_their_results_in_order() {
+        let items: Vec<u32> = (0..5).collect();
+        assert_eq!(side_by_side(&items, |&i| i * 10), [0, 10, 20, 30, 40]);
+        assert_eq!(side_by_side(&items[..1], |&i| i + 1), [1]);
+        assert!(side_by_side(&items[..0], |&i| i).is_empty());
+    }
+
+    #[test]
+    fn a_set_of_files_replaces_old_contents_and_leaves_no_staging_behind() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let (a, b, c) = (
+            dir.path().join("a.png"),
+            dir.path().join("b.png"),
+            dir.path().join("c.png"),
+        );
+        write_files_atomic(dir.path(), &[(&a, b"old a"), (&b, b"old b")]).expect("first set");
+        write_files_atomic(dir.path(), &[(&a, b"new a"), (&b, b"new b"), (&c, b"new c")]).expect("second set");
+        for (path, content) in [(&a, "new a"), (&b, "new b"), (&c, "new c")] {
+            assert_eq!(fs::read_to_string(path).expect("read"), content);
+        }
+        assert_eq!(
+            fs::read_dir(dir.path()).expect("list").count(),
+            3,
+            "no staging folder or backup is left"
         );
     }
 
