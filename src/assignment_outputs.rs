@@ -5,12 +5,15 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
-use crate::atomic_write::write_file_atomic;
+use crate::atomic_write::{parent_folder, write_files_atomic};
 use crate::film::{Film, OutputError, Tonemap, color_image, depth_image, encode_exr, encode_png, normals_image};
 use crate::provenance::Provenance;
 
 /// Encodes one output file.
 type Encode<'a> = Box<dyn Fn() -> Result<Vec<u8>, OutputError> + Sync + 'a>;
+
+/// Files to write into one folder: each target and its bytes.
+type FolderFiles<'a> = Vec<(&'a Path, &'a [u8])>;
 
 /// Where `goldray mit6837` writes, mirroring the course binary's `-output`, `-normals` and
 /// `-depth min max file` flags.
@@ -30,7 +33,7 @@ impl AssignmentOutputs {
     }
 
     /// Encodes every file before writing any, so a film that cannot be encoded writes nothing;
-    /// each file is then replaced atomically. The files are encoded in parallel, and each
+    /// the files are then replaced atomically, those of one folder all or nothing. The files are encoded in parallel, and each
     /// carries `provenance`: the course binary's PNGs carry no text chunks, but nothing that
     /// compares against them reads more than their pixels.
     pub fn write(&self, film: &Film, provenance: &Provenance) -> Result<Vec<PathBuf>, OutputError> {
@@ -58,11 +61,19 @@ impl AssignmentOutputs {
                 Ok((*path, provenance.stamp(&encode()?, &file)?))
             })
             .collect::<Result<Vec<(&Path, Vec<u8>)>, OutputError>>()?;
-        // Each file is synced before it replaces its target; syncing them side by side lets the
-        // file system commit them together rather than one after another.
-        files
-            .par_iter()
-            .try_for_each(|(path, bytes)| write_file_atomic(path, bytes))?;
+        // The files of one folder (usually all of them) replace their targets all or nothing,
+        // staged and synced side by side (`write_files_atomic`).
+        let mut folders: Vec<(&Path, FolderFiles)> = Vec::new();
+        for (path, bytes) in &files {
+            let folder = parent_folder(path);
+            match folders.iter_mut().find(|(known, _)| *known == folder) {
+                Some((_, group)) => group.push((path, bytes)),
+                None => folders.push((folder, vec![(path, bytes)])),
+            }
+        }
+        for (folder, group) in &folders {
+            write_files_atomic(folder, group)?;
+        }
         Ok(files.into_iter().map(|(path, _)| path.to_path_buf()).collect())
     }
 }

@@ -111,7 +111,8 @@ fn check_folder_writable(folder: &Path) -> io::Result<()> {
         .map(drop)
 }
 
-fn parent_folder(path: &Path) -> &Path {
+/// The folder `path` is written in: its parent, or `.` for a bare file name.
+pub fn parent_folder(path: &Path) -> &Path {
     match path.parent() {
         Some(parent) if !parent.as_os_str().is_empty() => parent,
         _ => Path::new("."),
@@ -139,20 +140,26 @@ pub fn write_files_atomic(dir: &Path, files: &[(&Path, &[u8])]) -> Result<(), At
         .tempdir_in(dir)
         .map_err(dir_error)?;
 
-    let mut staged = Vec::with_capacity(files.len());
-    for (i, &(target, bytes)) in files.iter().enumerate() {
-        let temp = staging.path().join(i.to_string());
-        write_synced(&temp, bytes).map_err(|source| AtomicWriteError::Write {
+    let staged: Vec<PathBuf> = (0..files.len()).map(|i| staging.path().join(i.to_string())).collect();
+    // Each file is synced before anything is renamed, so a crash leaves every target old or
+    // whole and new. The syncs wait on the disk, not the processor, and are issued side by side
+    // (a thread each) so that the file system commits them together: one after another, each
+    // waits for its own journal commit, a few milliseconds apiece on a busy disk.
+    let jobs: Vec<(&[u8], &PathBuf)> = files.iter().map(|&(_, bytes)| bytes).zip(&staged).collect();
+    let results = side_by_side(&jobs, |&(bytes, temp)| write_synced(temp, bytes));
+    for (&(target, _), result) in files.iter().zip(results) {
+        result.map_err(|source| AtomicWriteError::Write {
             path: target.to_path_buf(),
             source,
         })?;
-        staged.push(temp);
     }
 
     let mut installed: Vec<Installed> = Vec::with_capacity(files.len());
+    // Every target of a set keeps its old content until all are installed, the last one too
+    // (which is never rolled back), so that the old contents are freed side by side below rather
+    // than one by one inside the renames.
+    let needs_backup = files.len() > 1;
     for (i, (&(target, _), temp)) in files.iter().zip(&staged).enumerate() {
-        // The last target is never rolled back, so its old content needs no backup.
-        let needs_backup = i + 1 < files.len();
         let backup = staging.path().join(format!("{i}.previous"));
         let result =
             preserve(target, &backup, needs_backup).and_then(|previous| fs::rename(temp, target).map(|()| previous));
@@ -167,7 +174,42 @@ pub fn write_files_atomic(dir: &Path, files: &[(&Path, &[u8])]) -> Result<(), At
             }
         }
     }
+    // Freeing a replaced file can wait on the journal: about 4 ms each on ext4 mounted with
+    // `discard` (strace -T), most of a small render's writing. Unlinked side by side, a set of
+    // old contents costs about one such wait; the staging folder, then empty, goes on drop (which
+    // also removes whatever a failed unlink left).
+    let backups: Vec<PathBuf> = installed
+        .into_iter()
+        .filter_map(|installed| installed.previous)
+        .collect();
+    side_by_side(&backups, |backup| fs::remove_file(backup));
     Ok(())
+}
+
+/// `job` of every item, in order, each on a thread of its own so that jobs waiting on the disk
+/// wait together: inline for a single item, and for any item the system refuses a thread for.
+fn side_by_side<T: Sync, R: Send>(items: &[T], job: impl Fn(&T) -> R + Sync) -> Vec<R> {
+    if items.len() < 2 {
+        return items.iter().map(job).collect();
+    }
+    std::thread::scope(|scope| {
+        let job = &job;
+        let running: Vec<_> = items
+            .iter()
+            .map(|item| {
+                std::thread::Builder::new()
+                    .spawn_scoped(scope, move || job(item))
+                    .map_err(|_| item)
+            })
+            .collect();
+        running
+            .into_iter()
+            .map(|thread| match thread {
+                Ok(thread) => thread.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic)),
+                Err(item) => job(item),
+            })
+            .collect()
+    })
 }
 
 /// Keeps the current content of `target` at `backup` (when asked to and there is any), refusing a
@@ -261,6 +303,34 @@ mod tests {
             fs::read_dir(dir.path()).expect("list").count(),
             1,
             "a check leaves nothing behind"
+        );
+    }
+
+    #[test]
+    fn jobs_side_by_side_return_their_results_in_order() {
+        let items: Vec<u32> = (0..5).collect();
+        assert_eq!(side_by_side(&items, |&i| i * 10), [0, 10, 20, 30, 40]);
+        assert_eq!(side_by_side(&items[..1], |&i| i + 1), [1]);
+        assert!(side_by_side(&items[..0], |&i| i).is_empty());
+    }
+
+    #[test]
+    fn a_set_of_files_replaces_old_contents_and_leaves_no_staging_behind() {
+        let dir = tempfile::tempdir().expect("temp dir");
+        let (a, b, c) = (
+            dir.path().join("a.png"),
+            dir.path().join("b.png"),
+            dir.path().join("c.png"),
+        );
+        write_files_atomic(dir.path(), &[(&a, b"old a"), (&b, b"old b")]).expect("first set");
+        write_files_atomic(dir.path(), &[(&a, b"new a"), (&b, b"new b"), (&c, b"new c")]).expect("second set");
+        for (path, content) in [(&a, "new a"), (&b, "new b"), (&c, "new c")] {
+            assert_eq!(fs::read_to_string(path).expect("read"), content);
+        }
+        assert_eq!(
+            fs::read_dir(dir.path()).expect("list").count(),
+            3,
+            "no staging folder or backup is left"
         );
     }
 

@@ -23,8 +23,9 @@ struct Face {
     png: Vec<u8>,
     width: usize,
     height: usize,
-    /// Byte values row by row, row 0 at the top; or why the data could not be decoded.
-    texels: OnceLock<Result<Vec<[u8; 3]>, String>>,
+    /// Red, green and blue bytes texel by texel, row by row, row 0 at the top; or why the data
+    /// could not be decoded.
+    texels: OnceLock<Result<Vec<u8>, String>>,
 }
 
 #[derive(Debug)]
@@ -110,15 +111,13 @@ impl Face {
     }
 
     /// The decoded texels: decoded by the first ray to look, which any other waits for.
-    fn texels(&self) -> Option<&[[u8; 3]]> {
+    fn texels(&self) -> Option<&[u8]> {
         let texels = self.texels.get_or_init(|| {
-            let image = image::load_from_memory_with_format(&self.png, ImageFormat::Png)
-                .map_err(|e| e.to_string())?
-                .into_rgb8();
-            if (image.width() as usize, image.height() as usize) != (self.width, self.height) {
+            let texels = decode_rgb8(&self.png)?;
+            if texels.len() != self.width * self.height * 3 {
                 return Err("the image data does not match its header".to_string());
             }
-            Ok(image.pixels().map(|p| p.0).collect())
+            Ok(texels)
         });
         texels.as_deref().ok()
     }
@@ -128,19 +127,39 @@ impl Face {
         let values = byte_values();
         let x = u * self.width as Real;
         let y = (1.0 - v) * self.height as Real;
-        let (x0, y0) = (x.floor(), y.floor());
+        // `u` and `v` lie in [0, 1] (a component over the largest one, plus one, halved), so `x`
+        // and `y` are non-negative and truncation is `floor`, without the library call `floor`
+        // is on x86-64 without SSE4.1.
+        let (x0, y0) = (x as usize as Real, y as usize as Real);
         let (alpha, beta) = (x - x0, y - y0);
         let texel = |dx: Real, dy: Real| {
             let column = ((x0 + dx).max(0.0) as usize).min(self.width - 1);
             let row = ((y0 + dy).max(0.0) as usize).min(self.height - 1);
-            let [r, g, b] = texels[row * self.width + column];
-            Color::new(values[r as usize], values[g as usize], values[b as usize])
+            let texel = &texels[3 * (row * self.width + column)..][..3];
+            Color::new(values[texel[0] as usize], values[texel[1] as usize], values[texel[2] as usize])
         };
         texel(0.0, 0.0) * ((1.0 - alpha) * (1.0 - beta))
             + texel(1.0, 0.0) * (alpha * (1.0 - beta))
             + texel(0.0, 1.0) * ((1.0 - alpha) * beta)
             + texel(1.0, 1.0) * (alpha * beta)
     }
+}
+
+/// A face's texels as RGB bytes. An 8-bit RGB PNG (the course's faces) is decoded by the `png`
+/// crate straight into the buffer the texels are kept in, without the chunks' CRCs, which
+/// [`check_chunks`] verified at load; any other PNG is converted by `image`.
+fn decode_rgb8(png: &[u8]) -> Result<Vec<u8>, String> {
+    let mut decoder = png::Decoder::new(std::io::Cursor::new(png));
+    decoder.ignore_checksums(true);
+    let mut reader = decoder.read_info().map_err(|e| e.to_string())?;
+    if reader.output_color_type() != (png::ColorType::Rgb, png::BitDepth::Eight) {
+        let image = image::load_from_memory_with_format(png, ImageFormat::Png).map_err(|e| e.to_string())?;
+        return Ok(image.into_rgb8().into_raw());
+    }
+    let size = reader.output_buffer_size().ok_or("the image is too large")?;
+    let mut texels = vec![0; size];
+    reader.next_frame(&mut texels).map_err(|e| e.to_string())?;
+    Ok(texels)
 }
 
 /// Walks a PNG's chunks: the signature, each chunk's length within the file and its CRC, an
@@ -182,7 +201,7 @@ mod tests {
     use super::*;
 
     fn face(width: usize, height: usize, texels: Vec<[u8; 3]>) -> Face {
-        let texels = OnceLock::from(Ok(texels));
+        let texels = OnceLock::from(Ok(texels.into_flattened()));
         Face { path: PathBuf::new(), png: Vec::new(), width, height, texels }
     }
 
