@@ -21,6 +21,23 @@ impl<I: Isa> LeafVisitor<I> for NearestTriangle<'_, I> {
         nearest_in_packs(self.mesh, first, count, &self.ray, t_limit, &mut self.closest);
         Visit::Continue
     }
+
+    #[inline(always)]
+    fn prefetch(&self, first: u32, count: u32) {
+        prefetch_packs::<I>(self.mesh, first, count);
+    }
+}
+
+/// Asks for the cache lines of the packs `first..first + count`.
+#[inline(always)]
+fn prefetch_packs<I: Isa>(mesh: &Mesh, first: u32, count: u32) {
+    let packs = &mesh.packs[first as usize..(first + count) as usize];
+    let (start, end) = (packs.as_ptr().cast::<u8>(), packs.as_ptr_range().end.cast::<u8>());
+    let mut line = start.wrapping_sub(start as usize % 64);
+    while line < end {
+        I::prefetch(line);
+        line = line.wrapping_add(64);
+    }
 }
 
 /// Tests the packs `first..first + count` against one ray, keeping in `closest` the nearest
@@ -75,6 +92,11 @@ impl<I: Isa> LeafVisitor<I> for AnyTriangle<'_, I> {
             }
         }
         Visit::Continue
+    }
+
+    #[inline(always)]
+    fn prefetch(&self, first: u32, count: u32) {
+        prefetch_packs::<I>(self.mesh, first, count);
     }
 }
 
