@@ -88,15 +88,7 @@ pub fn traverse_packet<I: Isa>(
     loop {
         if current.count == 0 {
             let node = &nodes[current.index as usize];
-            // Rays not in the packet's current set get a limit below every entry distance, so
-            // that no box counts as entered by them.
-            let mut limits = [Real::NEG_INFINITY; PACKET];
-            for (lane, limit) in limits.iter_mut().enumerate() {
-                if current.rays & (1 << lane) != 0 {
-                    *limit = t_limit[lane] * BOX_SLACK;
-                }
-            }
-            let limit = R8::<I>::load(&limits);
+            let limit = R8::<I>::load(&t_limit[..]) * R8::<I>::splat(BOX_SLACK);
             let mut children = [(0u64, 0u32); WIDTH];
             let mut hit = 0;
             for slot in 0..WIDTH {
@@ -116,9 +108,25 @@ pub fn traverse_packet<I: Isa>(
                     t_exit = t_far.min(t_exit);
                 }
                 let entered_lanes = t_enter.le(t_exit);
-                let entered = entered_lanes.bits();
+                let any_ray = entered_lanes.bits();
+                let entered = any_ray & current.rays;
                 if entered != 0 {
-                    let nearest = min_lane::<I>(R8::<I>::select(entered_lanes, t_enter, R8::<I>::splat(Real::INFINITY)));
+                    // Usually every ray that enters the box is one of the current rays, and the
+                    // nearest entry is one select and a tree of minimums; else lane by lane.
+                    let nearest = if entered == any_ray {
+                        min_lane::<I>(R8::<I>::select(entered_lanes, t_enter, R8::<I>::splat(Real::INFINITY)))
+                    } else {
+                        let mut t = [0.0; PACKET];
+                        t_enter.store(&mut t);
+                        let mut nearest = Real::INFINITY;
+                        let mut remaining = entered;
+                        while remaining != 0 {
+                            let lane = remaining.trailing_zeros() as usize;
+                            remaining &= remaining - 1;
+                            nearest = nearest.min(t[lane]);
+                        }
+                        nearest
+                    };
                     // Sorted by the key, nearest first; the low bits carry the slot.
                     let mut k = hit;
                     let key = sort_key(nearest, slot);
