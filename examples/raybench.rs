@@ -147,7 +147,7 @@ fn run(dir: &Path, mesh_name: &str, rays_name: &str, threads: usize) -> Result<S
 /// Rays of any other count stay as they are.
 fn tiles(rays: Vec<Ray>) -> Vec<Ray> {
     let side = (rays.len() as f64).sqrt() as usize;
-    if side * side != rays.len() || side % 4 != 0 {
+    if side * side != rays.len() || !side.is_multiple_of(4) {
         return rays;
     }
     let mut tiled = Vec::with_capacity(rays.len());
