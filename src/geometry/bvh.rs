@@ -104,6 +104,11 @@ pub enum Visit {
 /// for certain, and one compiled on its own would run the lanes' instructions as calls).
 pub trait LeafVisitor<I: Isa> {
     fn leaf(&mut self, first: u32, count: u32, t_limit: &mut Real) -> Visit;
+
+    /// Called when a leaf is put on the traversal stack, so that its primitives can be asked
+    /// for from memory while the nearer children are visited (a hint: it must change nothing).
+    #[inline(always)]
+    fn prefetch(&self, _first: u32, _count: u32) {}
 }
 
 /// A closure as a [`LeafVisitor`], for visitors that use no lanes themselves.

@@ -107,17 +107,26 @@ pub fn traverse_packet<I: Isa>(
                     t_enter = t_near.max(t_enter);
                     t_exit = t_far.min(t_exit);
                 }
-                let entered = t_enter.le(t_exit).bits() & current.rays;
+                let entered_lanes = t_enter.le(t_exit);
+                let any_ray = entered_lanes.bits();
+                let entered = any_ray & current.rays;
                 if entered != 0 {
-                    let mut t = [0.0; PACKET];
-                    t_enter.store(&mut t);
-                    let mut nearest = Real::INFINITY;
-                    let mut remaining = entered;
-                    while remaining != 0 {
-                        let lane = remaining.trailing_zeros() as usize;
-                        remaining &= remaining - 1;
-                        nearest = nearest.min(t[lane]);
-                    }
+                    // Usually every ray that enters the box is one of the current rays, and the
+                    // nearest entry is one select and a tree of minimums; else lane by lane.
+                    let nearest = if entered == any_ray {
+                        min_lane::<I>(R8::<I>::select(entered_lanes, t_enter, R8::<I>::splat(Real::INFINITY)))
+                    } else {
+                        let mut t = [0.0; PACKET];
+                        t_enter.store(&mut t);
+                        let mut nearest = Real::INFINITY;
+                        let mut remaining = entered;
+                        while remaining != 0 {
+                            let lane = remaining.trailing_zeros() as usize;
+                            remaining &= remaining - 1;
+                            nearest = nearest.min(t[lane]);
+                        }
+                        nearest
+                    };
                     // Sorted by the key, nearest first; the low bits carry the slot.
                     let mut k = hit;
                     let key = sort_key(nearest, slot);
@@ -147,21 +156,23 @@ pub fn traverse_packet<I: Isa>(
         loop {
             let Some(pending) = stack.pop() else { return };
             // Only the rays that have found nothing nearer than where the box is entered go on.
-            let mut rays = 0;
-            let mut remaining = pending.rays;
-            while remaining != 0 {
-                let lane = remaining.trailing_zeros();
-                remaining &= remaining - 1;
-                if pending.t <= t_limit[lane as usize] * BOX_SLACK {
-                    rays |= 1 << lane;
-                }
-            }
+            let limit = R8::<I>::load(&t_limit[..]) * R8::<I>::splat(BOX_SLACK);
+            let rays = R8::<I>::splat(pending.t).le(limit).bits() & pending.rays;
             if rays != 0 {
                 current = PacketPending { rays, ..pending };
                 break;
             }
         }
     }
+}
+
+/// The smallest lane (none being NaN), by a tree of minimums over the stored lanes.
+#[inline(always)]
+fn min_lane<I: Isa>(lanes: R8<I>) -> Real {
+    let mut t = [0.0; PACKET];
+    lanes.store(&mut t);
+    let pairs = [t[0].min(t[4]), t[1].min(t[5]), t[2].min(t[6]), t[3].min(t[7])];
+    pairs[0].min(pairs[2]).min(pairs[1].min(pairs[3]))
 }
 
 /// The distance a [`sort_key`] was made from, to within its dropped low bits (rounded down, so

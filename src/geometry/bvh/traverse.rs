@@ -74,47 +74,29 @@ pub(super) fn sort_key(t: Real, lane: usize) -> u64 {
     key | lane as u64
 }
 
-/// Entries the traversal stack holds in place before it spills to the heap. Rays rarely need
-/// more than a few dozen, and a small frame keeps the kernels that do not traverse cheap.
-const INLINE_STACK: usize = 64;
-
-/// The traversal stack: `INLINE_STACK` entries inline and, unlike an array, not initialised
-/// (zeroing them for every ray would cost more than most rays push), then a vector for the
-/// deepest trees (at most `STACK_SIZE` entries in all), allocated only if ever needed.
+/// The traversal stack: room for `STACK_SIZE` entries, the most any tree can need, and, unlike
+/// an array, not initialised (zeroing them for every ray would cost more than most rays push).
+/// A push never checks for room and a pop only for emptiness.
 struct Stack {
-    entries: [MaybeUninit<Pending>; INLINE_STACK],
+    entries: [MaybeUninit<Pending>; STACK_SIZE],
     len: usize,
-    spilled: Vec<Pending>,
 }
 
 impl Stack {
     #[inline(always)]
     fn new() -> Self {
-        Stack { entries: [const { MaybeUninit::uninit() }; INLINE_STACK], len: 0, spilled: Vec::new() }
+        Stack { entries: [const { MaybeUninit::uninit() }; STACK_SIZE], len: 0 }
     }
 
     #[inline(always)]
     fn push(&mut self, entry: Pending) {
-        if self.len < INLINE_STACK {
-            self.entries[self.len] = MaybeUninit::new(entry);
-            self.len += 1;
-        } else {
-            self.spill(entry);
-        }
-    }
-
-    #[cold]
-    #[inline(never)]
-    fn spill(&mut self, entry: Pending) {
-        debug_assert!(self.spilled.len() + INLINE_STACK < STACK_SIZE);
-        self.spilled.push(entry);
+        // In bounds: each node visited pushes at most `WIDTH - 1` entries (see `STACK_SIZE`).
+        self.entries[self.len] = MaybeUninit::new(entry);
+        self.len += 1;
     }
 
     #[inline(always)]
     fn pop(&mut self) -> Option<Pending> {
-        if !self.spilled.is_empty() {
-            return self.spilled.pop();
-        }
         if self.len == 0 {
             return None;
         }
@@ -124,14 +106,17 @@ impl Stack {
     }
 }
 
-/// A child that waits on the stack is fetched from memory meanwhile.
+/// A child that waits on the stack is fetched from memory meanwhile: a node here, a leaf's
+/// primitives by the visitor.
 #[inline(always)]
-fn fetch_node<I: Isa>(nodes: &[BvhNode], pending: &Pending) {
+fn fetch<I: Isa>(nodes: &[BvhNode], pending: &Pending, visitor: &impl LeafVisitor<I>) {
     if pending.count == 0 {
         let waiting: *const BvhNode = &nodes[pending.index as usize];
         for line in 0..size_of::<BvhNode>().div_ceil(64) {
             I::prefetch(waiting.cast::<u8>().wrapping_add(64 * line));
         }
+    } else {
+        visitor.prefetch(pending.index, pending.count);
     }
 }
 
@@ -165,12 +150,11 @@ pub fn traverse<I: Isa>(nodes: &[BvhNode], ray: &Ray, t_max: Real, visitor: &mut
                 let mut t = [0.0; WIDTH];
                 t_enter.store(&mut t);
                 let child = |lane: usize| Pending { t: t[lane], index: node.child[lane], count: node.count[lane] };
-                let fetch = |pending: &Pending| fetch_node::<I>(nodes, pending);
                 if rest & (rest - 1) == 0 {
                     // Two children, the common case: the farther one waits.
                     let second = rest.trailing_zeros() as usize;
                     let (near, far) = if t[second] < t[first] { (second, first) } else { (first, second) };
-                    fetch(&child(far));
+                    fetch::<I>(nodes, &child(far), visitor);
                     stack.push(child(far));
                     current = child(near);
                     continue;
@@ -193,7 +177,7 @@ pub fn traverse<I: Isa>(nodes: &[BvhNode], ray: &Ray, t_max: Real, visitor: &mut
                 }
                 for &key in keys[1..len].iter().rev() {
                     let waiting = child(key as usize & (WIDTH - 1));
-                    fetch(&waiting);
+                    fetch::<I>(nodes, &waiting, visitor);
                     stack.push(waiting);
                 }
                 current = child(keys[0] as usize & (WIDTH - 1));

@@ -18,29 +18,60 @@ pub(super) struct NearestTriangle<'a, I: Isa> {
 impl<I: Isa> LeafVisitor<I> for NearestTriangle<'_, I> {
     #[inline(always)]
     fn leaf(&mut self, first: u32, count: u32, t_limit: &mut Real) -> Visit {
-        for pack in &self.mesh.packs[first as usize..(first + count) as usize] {
-            let found = intersect_pack::<I>(pack, &self.ray, *t_limit);
-            let mut lanes = found.lanes;
-            if lanes == 0 {
-                continue;
-            }
-            let values = found.values::<4>();
-            while lanes != 0 {
-                let lane = lanes.trailing_zeros() as usize;
-                lanes &= lanes - 1;
-                let (t, triangle) = (values[0][lane], pack.ids()[lane]);
-                let nearer = match &self.closest {
-                    Some(best) => t < best.t || (t == best.t && triangle < best.triangle),
-                    None => true,
-                };
-                if nearer {
-                    let hit = lane_hit(&values, lane);
-                    *t_limit = t;
-                    self.closest = Some(MeshHit { t, triangle, barycentrics: [hit.b0, hit.b1, hit.b2] });
-                }
+        nearest_in_packs(self.mesh, first, count, &self.ray, t_limit, &mut self.closest);
+        Visit::Continue
+    }
+
+    #[inline(always)]
+    fn prefetch(&self, first: u32, count: u32) {
+        prefetch_packs::<I>(self.mesh, first, count);
+    }
+}
+
+/// Asks for the cache lines of the packs `first..first + count`.
+#[inline(always)]
+fn prefetch_packs<I: Isa>(mesh: &Mesh, first: u32, count: u32) {
+    let packs = &mesh.packs[first as usize..(first + count) as usize];
+    let (start, end) = (packs.as_ptr().cast::<u8>(), packs.as_ptr_range().end.cast::<u8>());
+    let mut line = start.wrapping_sub(start as usize % 64);
+    while line < end {
+        I::prefetch(line);
+        line = line.wrapping_add(64);
+    }
+}
+
+/// Tests the packs `first..first + count` against one ray, keeping in `closest` the nearest
+/// hit (the smaller triangle index among hits at the same `t`) and in `t_limit` its `t`.
+#[inline(always)]
+fn nearest_in_packs<I: Isa>(
+    mesh: &Mesh,
+    first: u32,
+    count: u32,
+    ray: &PackRay<I>,
+    t_limit: &mut Real,
+    closest: &mut Option<MeshHit>,
+) {
+    for pack in &mesh.packs[first as usize..(first + count) as usize] {
+        let found = intersect_pack::<I>(pack, ray, *t_limit);
+        let mut lanes = found.lanes;
+        if lanes == 0 {
+            continue;
+        }
+        let values = found.values::<4>();
+        while lanes != 0 {
+            let lane = lanes.trailing_zeros() as usize;
+            lanes &= lanes - 1;
+            let (t, triangle) = (values[0][lane], pack.ids()[lane]);
+            let nearer = match closest {
+                Some(best) => t < best.t || (t == best.t && triangle < best.triangle),
+                None => true,
+            };
+            if nearer {
+                let hit = lane_hit(&values, lane);
+                *t_limit = t;
+                *closest = Some(MeshHit { t, triangle, barycentrics: [hit.b0, hit.b1, hit.b2] });
             }
         }
-        Visit::Continue
     }
 }
 
@@ -62,7 +93,15 @@ impl<I: Isa> LeafVisitor<I> for AnyTriangle<'_, I> {
         }
         Visit::Continue
     }
+
+    #[inline(always)]
+    fn prefetch(&self, first: u32, count: u32) {
+        prefetch_packs::<I>(self.mesh, first, count);
+    }
 }
+
+/// Up to this many rays at a leaf, [`NearestTriangles`] tests them one by one.
+const FEW_RAYS: u32 = 4;
 
 /// The leaf test of [`Mesh::intersect_packet`]: each triangle of the leaf against the rays
 /// that reached it, keeping each ray's nearest hit as [`NearestTriangle`] does.
@@ -75,6 +114,19 @@ pub(super) struct NearestTriangles<'a, I: Isa> {
 impl<I: Isa> PacketVisitor<I> for NearestTriangles<'_, I> {
     #[inline(always)]
     fn leaf(&mut self, first: u32, count: u32, rays: u32, t_limit: &mut [Real; PACKET]) {
+        // A leaf reached by few rays tests its packs against each of them, four triangles at a
+        // time, rather than each triangle against all eight lanes. Both tests give each ray
+        // the same hits, bit for bit.
+        if rays.count_ones() <= FEW_RAYS {
+            let mut remaining = rays;
+            while remaining != 0 {
+                let lane = remaining.trailing_zeros() as usize;
+                remaining &= remaining - 1;
+                let ray = self.rays.pack_ray(lane);
+                nearest_in_packs(self.mesh, first, count, &ray, &mut t_limit[lane], &mut self.closest[lane]);
+            }
+            return;
+        }
         for pack in &self.mesh.packs[first as usize..(first + count) as usize] {
             let mut live = pack.live();
             while live != 0 {

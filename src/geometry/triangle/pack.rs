@@ -161,6 +161,8 @@ pub struct RayLanes<I: Isa> {
     /// Each ray's origin, permuted.
     origin: [R8<I>; 3],
     shear: [R8<I>; 3],
+    /// The lanes of `origin` and then `shear` as values, for [`RayLanes::pack_ray`].
+    values: [[Real; 8]; 6],
 }
 
 impl<I: Isa> RayLanes<I> {
@@ -194,7 +196,20 @@ impl<I: Isa> RayLanes<I> {
             },
             origin: [R8::<I>::load(&l[0]), R8::<I>::load(&l[1]), R8::<I>::load(&l[2])],
             shear: [R8::<I>::load(&l[3]), R8::<I>::load(&l[4]), R8::<I>::load(&l[5])],
+            values: lanes,
         })
+    }
+
+    /// Lane `lane`'s ray as [`PackRay::new`] makes it, for testing a pack's four triangles
+    /// against that ray alone (cheaper than four tests of all eight lanes when few rays are left).
+    #[inline(always)]
+    pub fn pack_ray(&self, lane: usize) -> PackRay<I> {
+        let v = &self.values;
+        PackRay {
+            axes: self.axes,
+            origin: [R4::<I>::splat(v[0][lane]), R4::<I>::splat(v[1][lane]), R4::<I>::splat(v[2][lane])],
+            shear: [R4::<I>::splat(v[3][lane]), R4::<I>::splat(v[4][lane]), R4::<I>::splat(v[5][lane])],
+        }
     }
 }
 
