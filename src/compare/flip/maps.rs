@@ -2,6 +2,7 @@
 //! responses, by separable filtering with edge values repeated past the border, each pixel's taps
 //! summed in the reference implementation's order (so that the maps round as its maps do).
 
+use std::cell::RefCell;
 use std::ops::Range;
 
 use image::RgbImage;
@@ -57,40 +58,58 @@ impl Maps {
         let k = &*KERNELS;
         let reach = k.spatial_radius().max(k.feature_radius());
         let read = rows.start.saturating_sub(reach)..(rows.end + reach).min(height);
-        let mut opponent: [Vec<f32>; 3] = std::array::from_fn(|_| Vec::with_capacity(read.len() * width));
-        let bytes = &picture.as_raw()[read.start * width * 3..read.end * width * 3];
-        for pixel in bytes.chunks_exact(3) {
-            let value = srgb_to_ycxcz([pixel[0], pixel[1], pixel[2]]);
-            for (plane, v) in opponent.iter_mut().zip(value) {
-                plane.push(v);
-            }
-        }
         let band = Band {
             width,
             height,
-            read,
+            read: read.clone(),
             rows: rows.clone(),
         };
-        let filter = |plane: &[f32], across: &[f32], down: &[f32]| band.vertical(&band.horizontal(plane, across), down);
-        let first_blue_yellow = filter(&opponent[2], &k.blue_yellow[0], &k.blue_yellow[0]);
-        let second_blue_yellow = filter(&opponent[2], &k.blue_yellow[1], &k.blue_yellow[1]);
-        let color = [
-            filter(&opponent[0], &k.achromatic, &k.achromatic),
-            filter(&opponent[1], &k.red_green, &k.red_green),
-            first_blue_yellow
-                .iter()
-                .zip(&second_blue_yellow)
-                .map(|(a, b)| a + b)
-                .collect(),
-        ];
-        let gray: Vec<f32> = opponent[0].iter().map(|&y| feature_input(y)).collect();
-        let smoothed = band.horizontal(&gray, &k.gaussian);
-        let features = [
-            band.vertical(&band.horizontal(&gray, &k.first), &k.gaussian),
-            band.vertical(&smoothed, &k.first),
-            band.vertical(&band.horizontal(&gray, &k.second), &k.gaussian),
-            band.vertical(&smoothed, &k.second),
-        ];
+        let (color, features) = SCRATCH.with_borrow_mut(|scratch| {
+            let Scratch {
+                opponent,
+                gray,
+                across,
+                smoothed,
+                second,
+            } = scratch;
+            for plane in opponent.iter_mut() {
+                plane.clear();
+            }
+            for pixel in picture.as_raw()[read.start * width * 3..read.end * width * 3].chunks_exact(3) {
+                let value = srgb_to_ycxcz([pixel[0], pixel[1], pixel[2]]);
+                for (plane, v) in opponent.iter_mut().zip(value) {
+                    plane.push(v);
+                }
+            }
+            let mut filter = |plane: &[f32], taps: &[f32]| {
+                band.horizontal(plane, taps, across);
+                band.vertical(across, taps)
+            };
+            let mut color = [
+                filter(&opponent[0], &k.achromatic),
+                filter(&opponent[1], &k.red_green),
+                filter(&opponent[2], &k.blue_yellow[0]),
+            ];
+            band.horizontal(&opponent[2], &k.blue_yellow[1], across);
+            band.vertical_into(across, &k.blue_yellow[1], second);
+            for (first, second) in color[2].iter_mut().zip(second.iter()) {
+                *first += second;
+            }
+            gray.clear();
+            gray.extend(opponent[0].iter().map(|&y| feature_input(y)));
+            band.horizontal(gray, &k.gaussian, smoothed);
+            band.horizontal(gray, &k.first, across);
+            let dx = band.vertical(across, &k.gaussian);
+            band.horizontal(gray, &k.second, across);
+            let ddx = band.vertical(across, &k.gaussian);
+            let features = [
+                dx,
+                band.vertical(smoothed, &k.first),
+                ddx,
+                band.vertical(smoothed, &k.second),
+            ];
+            (color, features)
+        });
         Maps {
             width,
             rows,
@@ -98,7 +117,6 @@ impl Maps {
             features,
         }
     }
-
     /// The pixels (indices into the whole picture) the maps cover.
     pub fn pixels(&self) -> Range<usize> {
         self.rows.start * self.width..self.rows.end * self.width
@@ -131,12 +149,29 @@ struct Band {
     rows: Range<usize>,
 }
 
+/// The working planes of one filtering, kept by each thread: a class's pictures are filtered one
+/// after another, and planes made afresh for each cost a page fault every 4 KB (most of the
+/// system time of grading a class).
+#[derive(Default)]
+struct Scratch {
+    opponent: [Vec<f32>; 3],
+    gray: Vec<f32>,
+    across: Vec<f32>,
+    smoothed: Vec<f32>,
+    second: Vec<f32>,
+}
+
+thread_local! {
+    static SCRATCH: RefCell<Scratch> = RefCell::default();
+}
+
 impl Band {
-    /// Each row of `plane` (the rows `read`) filtered by `taps`, the row's end values repeated
-    /// past its ends.
-    fn horizontal(&self, plane: &[f32], taps: &[f32]) -> Vec<f32> {
+    /// Each row of `plane` (the rows `read`) filtered by `taps` into `out`, the row's end values
+    /// repeated past its ends.
+    fn horizontal(&self, plane: &[f32], taps: &[f32], out: &mut Vec<f32>) {
         let (width, radius) = (self.width, taps.len() / 2);
-        let mut out = vec![0.0f32; plane.len()];
+        out.clear();
+        out.resize(plane.len(), 0.0);
         let mut padded = vec![0.0f32; width + 2 * radius];
         for (row, out_row) in plane.chunks_exact(width).zip(out.chunks_exact_mut(width)) {
             for (i, p) in padded.iter_mut().enumerate() {
@@ -148,14 +183,21 @@ impl Band {
                 }
             }
         }
-        out
     }
 
     /// The band's rows of `plane` (the rows `read`) filtered down the columns by `taps`, the
     /// picture's first and last rows repeated past its ends.
     fn vertical(&self, plane: &[f32], taps: &[f32]) -> Vec<f32> {
+        let mut out = Vec::new();
+        self.vertical_into(plane, taps, &mut out);
+        out
+    }
+
+    /// [`Band::vertical`] into `out`.
+    fn vertical_into(&self, plane: &[f32], taps: &[f32], out: &mut Vec<f32>) {
         let (width, radius) = (self.width, taps.len() / 2);
-        let mut out = vec![0.0f32; self.rows.len() * width];
+        out.clear();
+        out.resize(self.rows.len() * width, 0.0);
         for (y, out_row) in self.rows.clone().zip(out.chunks_exact_mut(width)) {
             for (t, &tap) in taps.iter().enumerate() {
                 let source = (y + t).saturating_sub(radius).min(self.height - 1) - self.read.start;
@@ -164,6 +206,5 @@ impl Band {
                 }
             }
         }
-        out
     }
 }
