@@ -28,10 +28,8 @@ static LINEAR: LazyLock<[f32; 256]> = LazyLock::new(|| {
 });
 
 /// The largest colour difference (green against blue), after the exponent.
-static MAX_DISTANCE: LazyLock<f32> = LazyLock::new(|| {
-    let hunt_lab = |rgb| hunt(xyz_to_lab(linear_rgb_to_xyz(rgb)));
-    hyab(hunt_lab([0.0, 1.0, 0.0]), hunt_lab([0.0, 0.0, 1.0])).powf(QC)
-});
+static MAX_DISTANCE: LazyLock<f32> =
+    LazyLock::new(|| hyab(hunt_lab([0.0, 1.0, 0.0]), hunt_lab([0.0, 0.0, 1.0])).powf(QC));
 
 /// An 8-bit sRGB pixel in FLIP's opponent space YCxCz (achromatic, red-green, blue-yellow).
 pub(super) fn srgb_to_ycxcz(pixel: [u8; 3]) -> [f32; 3] {
@@ -47,11 +45,12 @@ pub(super) fn feature_input(achromatic: f32) -> f32 {
 /// in CIELAB with the Hunt adjustment.
 pub(super) fn perceived(ycxcz: [f32; 3]) -> [f32; 3] {
     let [r, g, b] = xyz_to_linear_rgb(ycxcz_to_xyz(ycxcz));
-    hunt(xyz_to_lab(linear_rgb_to_xyz([
-        r.clamp(0.0, 1.0),
-        g.clamp(0.0, 1.0),
-        b.clamp(0.0, 1.0),
-    ])))
+    hunt_lab([r.clamp(0.0, 1.0), g.clamp(0.0, 1.0), b.clamp(0.0, 1.0)])
+}
+
+/// A linear RGB colour in CIELAB with the Hunt adjustment.
+fn hunt_lab(rgb: [f32; 3]) -> [f32; 3] {
+    hunt(xyz_to_lab(linear_rgb_to_xyz(rgb)))
 }
 
 /// The colour error of two [`perceived`] colours, in [0, 1].

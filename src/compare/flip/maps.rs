@@ -7,7 +7,7 @@ use std::ops::Range;
 
 use image::RgbImage;
 
-use super::color::{feature_input, perceived, srgb_to_ycxcz, strengths};
+use super::color::{color_error, feature_input, flip_error, perceived, srgb_to_ycxcz, strengths};
 use super::kernels::KERNELS;
 
 /// What FLIP's per-pixel error reads of one picture, over a band of its rows.
@@ -47,6 +47,13 @@ impl Reference {
             strengths: (0..pixels).map(|p| strengths(maps.features(p))).collect(),
             maps,
         }
+    }
+
+    /// FLIP's error at `pixel` of a picture whose filtered colour and feature responses there are
+    /// `color` and `features`.
+    pub(super) fn error(&self, pixel: usize, color: [f32; 3], features: [f32; 4]) -> f32 {
+        let color_error = color_error(self.perceived[pixel], perceived(color));
+        flip_error(color_error, self.strengths[pixel], strengths(features))
     }
 }
 

@@ -77,12 +77,7 @@ fn dense_error_sum(reference: &Reference, test: &Maps) -> f64 {
             if color == reference.maps.color(p) && features == reference.maps.features(p) {
                 return 0.0;
             }
-            let color_error = color::color_error(reference.perceived[p], color::perceived(color));
-            f64::from(color::flip_error(
-                color_error,
-                reference.strengths[p],
-                color::strengths(features),
-            ))
+            f64::from(reference.error(p, color, features))
         })
         .sum()
 }

@@ -5,7 +5,7 @@
 
 use image::RgbImage;
 
-use super::color::{color_error, feature_input, flip_error, perceived, srgb_to_ycxcz, strengths};
+use super::color::{feature_input, srgb_to_ycxcz};
 use super::kernels::{KERNELS, clamped_weight};
 use super::maps::Reference;
 
@@ -64,8 +64,7 @@ pub(super) fn error_sum(picture: &RgbImage, reference: &Reference, test: &RgbIma
             let (color, features) = (reference.maps.color(p), reference.maps.features(p));
             let color = [0, 1, 2].map(|c| color[c] + change[c]);
             let features = [0, 1, 2, 3].map(|c| features[c] + change[3 + c]);
-            let color_error = color_error(reference.perceived[p], perceived(color));
-            f64::from(flip_error(color_error, reference.strengths[p], strengths(features)))
+            f64::from(reference.error(p, color, features))
         })
         .sum()
 }
