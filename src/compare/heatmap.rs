@@ -57,21 +57,15 @@ fn heatmap_with(expected: &Image, actual: &Image, pixel_threshold: f64, colour: 
         .map(|e| COLOR_CHANNELS.iter().position(|&c| c == e.name))
         .collect();
     let mut heatmap = RgbImage::from_fn(expected.width, expected.height, |x, y| backdrop(expected, x, y));
+    let equal_rows = super::metrics::equal_rows(expected, actual);
     for y in 0..expected.height {
-        let row = y as usize * width..(y as usize + 1) * width;
         // A row equal in every channel is all backdrop (a zero difference fails no threshold
         // that is not negative): most rows of a graded picture.
-        if pixel_threshold >= 0.0
-            && expected
-                .channels
-                .iter()
-                .zip(&actual.channels)
-                .all(|(e, a)| e.values[row.clone()] == a.values[row.clone()])
-        {
+        if pixel_threshold >= 0.0 && equal_rows[y as usize] {
             continue;
         }
         for x in 0..expected.width {
-            let i = row.start + x as usize;
+            let i = y as usize * width + x as usize;
             let mut largest = 0.0_f64;
             let mut failing = false;
             let mut broken = false;
