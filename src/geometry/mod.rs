@@ -3,6 +3,7 @@
 pub mod aabb;
 pub mod bvh;
 pub mod generate;
+pub mod lanes;
 pub mod mesh;
 pub mod obj;
 pub mod plane;

@@ -2,6 +2,7 @@
 //! the BVH.
 
 use super::ray::{Ray, SurfaceHit};
+use super::lanes::{RayLanes, SurfaceLanes, V3};
 use super::real::{R8, Real, Vec3, gamma};
 use crate::simd::{Isa, Lanes, MaskOps};
 
@@ -90,6 +91,38 @@ pub fn intersect_planes<I: Isa>(pack: &PlanePack, ray: &Ray, t_max: Real) -> (u3
     let zero = splat(0.0);
     let hit = t.gt(zero).and(t.le(splat(t_max))).and(t.abs().lt(splat(Real::INFINITY))).and_not(denominator.eq(zero));
     (hit.bits() & pack.live, t)
+}
+
+impl Plane {
+    /// [`Plane::intersect`] for a ray per lane, each with its own `t_max`, with the same
+    /// operations in the same order: a bit per lane hit, and each lane's `t`.
+    ///
+    /// A kernel: compile it only inside one (see `crate::simd`).
+    #[inline(always)]
+    pub fn intersect_rays<I: Isa>(&self, rays: &RayLanes<I>, t_max: R8<I>) -> (u32, R8<I>) {
+        let normal = V3::<I>::splat(self.normal);
+        let denominator = normal.dot(rays.direction);
+        let t = (R8::<I>::splat(self.offset) - normal.dot(rays.origin)) / denominator;
+        let zero = R8::<I>::splat(0.0);
+        let hit = t.gt(zero).and(t.le(t_max)).and(t.abs().lt(R8::<I>::splat(Real::INFINITY))).and_not(denominator.eq(zero));
+        (hit.bits(), t)
+    }
+
+    /// [`Plane::surface`] for a ray per lane, each lane's plane given by its normal, offset and
+    /// shading normal.
+    #[inline(always)]
+    pub fn surface_lanes<I: Isa>(
+        normal: V3<I>,
+        offset: R8<I>,
+        shading_normal: V3<I>,
+        rays: &RayLanes<I>,
+        t: R8<I>,
+    ) -> SurfaceLanes<I> {
+        let along = rays.at(t);
+        let point = along - normal.scale(normal.dot(along) - offset);
+        let point_error = (point.abs() + normal.abs().scale(offset.abs())).scale(R8::<I>::splat(gamma(7)));
+        SurfaceLanes { t, point, point_error, geometric_normal: normal, shading_normal }
+    }
 }
 
 #[cfg(test)]

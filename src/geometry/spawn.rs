@@ -2,9 +2,11 @@
 //! never put their origin on the wrong side, which no fixed epsilon can promise at every scale
 //! (pbrt-v4 `OffsetRayOrigin`).
 
+use super::lanes::{RayLanes, SurfaceLanes, V3};
 use super::ray::{Ray, SurfaceHit};
-use super::real::{Real, Vec3, real};
+use super::real::{R8, Real, Vec3, real};
 use crate::options::Spawn;
+use crate::simd::{Isa, Lanes};
 
 /// Shadow rays to a point stop this fraction short of it, so that a light sitting on a surface
 /// is not shadowed by that surface. Relative, so it scales with the scene.
@@ -67,6 +69,63 @@ pub fn spawn_to(policy: Spawn, hit: &SurfaceHit, target: Vec3) -> (Ray, Real) {
             let distance = to_target.length();
             let direction = to_target / distance;
             (Ray::new(hit.point + direction * real(Spawn::COURSE_OFFSET), direction), distance)
+        }
+    }
+}
+
+/// [`spawn_ray_offset`] for a hit and a direction per lane.
+#[inline(always)]
+fn spawn_offset_lanes<I: Isa>(hit: &SurfaceLanes<I>, direction: V3<I>) -> V3<I> {
+    let normal = hit.geometric_normal;
+    let distance = normal.abs().dot(hit.point_error);
+    let offset = normal.scale(distance);
+    let offset = V3::select(direction.dot(normal).lt(R8::<I>::splat(0.0)), -offset, offset);
+    let mut origin = (hit.point + offset).store();
+    let offset = offset.store();
+    for (origin, offset) in origin.iter_mut().zip(&offset) {
+        for (origin, &offset) in origin.iter_mut().zip(offset) {
+            if offset > 0.0 {
+                *origin = origin.next_up();
+            } else if offset < 0.0 {
+                *origin = origin.next_down();
+            }
+        }
+    }
+    V3::load(&origin)
+}
+
+/// [`spawn`] for a hit and a direction per lane.
+#[inline(always)]
+pub fn spawn_lanes<I: Isa>(policy: Spawn, hit: &SurfaceLanes<I>, direction: V3<I>) -> RayLanes<I> {
+    let origin = match policy {
+        Spawn::ErrorBounds => spawn_offset_lanes(hit, direction),
+        Spawn::FixedEpsilon(epsilon) => hit.point + direction.normalize().scale(R8::<I>::splat(real(epsilon))),
+        Spawn::Course => hit.point + direction.scale(R8::<I>::splat(real(Spawn::COURSE_OFFSET))),
+    };
+    RayLanes { origin, direction }
+}
+
+/// [`spawn_to`] for a hit and a target per lane: the rays and each lane's `t_max`.
+#[inline(always)]
+pub fn spawn_to_lanes<I: Isa>(policy: Spawn, hit: &SurfaceLanes<I>, target: V3<I>) -> (RayLanes<I>, R8<I>) {
+    let splat = R8::<I>::splat;
+    match policy {
+        Spawn::ErrorBounds => {
+            let origin = spawn_offset_lanes(hit, target - hit.point);
+            (RayLanes { origin, direction: target - origin }, splat(1.0 - SHADOW_RAY_SHORTFALL))
+        }
+        Spawn::FixedEpsilon(epsilon) => {
+            let to_target = target - hit.point;
+            let skipped = splat(real(epsilon)) / to_target.length();
+            let origin = hit.point + to_target.scale(skipped);
+            (RayLanes { origin, direction: to_target }, splat(1.0) - splat(2.0) * skipped)
+        }
+        Spawn::Course => {
+            let to_target = target - hit.point;
+            let distance = to_target.length();
+            let direction = to_target.divide(distance);
+            let origin = hit.point + direction.scale(splat(real(Spawn::COURSE_OFFSET)));
+            (RayLanes { origin, direction }, distance)
         }
     }
 }

@@ -3,6 +3,7 @@
 
 use super::aabb::Aabb;
 use super::ray::{Ray, SurfaceHit};
+use super::lanes::{Mask, RayLanes, SurfaceLanes, V3};
 use super::real::{R8, Real, Vec3, gamma};
 use crate::simd::{Isa, Lanes, MaskOps};
 
@@ -113,7 +114,8 @@ impl SpherePack {
     }
 }
 
-/// The per-ray part of [`intersect_spheres`], splatted across the lanes.
+/// The per-ray part of [`intersect_spheres`]: one ray splatted across the lanes, or a ray per
+/// lane ([`SphereRay::lanes`]).
 pub struct SphereRay<I: Isa> {
     origin: [R8<I>; 3],
     direction: [R8<I>; 3],
@@ -121,42 +123,43 @@ pub struct SphereRay<I: Isa> {
     a: R8<I>,
     two_a: R8<I>,
     four_a: R8<I>,
-    /// Zero-length directions hit nothing.
-    moving: bool,
+    /// Lanes whose direction has zero length, which hit nothing.
+    still: Mask<I>,
 }
 
 impl<I: Isa> SphereRay<I> {
     #[inline(always)]
     pub fn new(ray: &Ray) -> Self {
-        let (o, d) = (ray.origin, ray.direction);
+        SphereRay::lanes(&RayLanes { origin: V3::splat(ray.origin), direction: V3::splat(ray.direction) })
+    }
+
+    /// A ray per lane.
+    #[inline(always)]
+    pub fn lanes(rays: &RayLanes<I>) -> Self {
+        let (o, d) = (rays.origin, rays.direction);
         let a = d.length_squared();
         SphereRay {
-            origin: [R8::<I>::splat(o.x), R8::<I>::splat(o.y), R8::<I>::splat(o.z)],
-            direction: [R8::<I>::splat(d.x), R8::<I>::splat(d.y), R8::<I>::splat(d.z)],
-            a: R8::<I>::splat(a),
-            two_a: R8::<I>::splat(2.0 * a),
-            four_a: R8::<I>::splat(4.0 * a),
-            moving: a != 0.0,
+            origin: [o.x, o.y, o.z],
+            direction: [d.x, d.y, d.z],
+            a,
+            two_a: R8::<I>::splat(2.0) * a,
+            four_a: R8::<I>::splat(4.0) * a,
+            still: a.eq(R8::<I>::splat(0.0)),
         }
     }
 }
 
-/// [`Sphere::intersect`] on the lanes of `pack`, with the same operations in the same order:
-/// a bit per lane hit in `(0, t_max]`, and each lane's `t`.
-///
-/// A kernel: compile it only inside one (see `crate::simd`).
+/// [`Sphere::intersect`] on eight lanes, each a sphere and a ray (either may be the same in
+/// every lane), with the same operations in the same order: a bit per lane hit in `(0, t_max]`,
+/// and each lane's `t`.
 #[inline(always)]
-pub fn intersect_spheres<I: Isa>(pack: &SpherePack, ray: &SphereRay<I>, t_max: Real) -> (u32, R8<I>) {
+fn intersect_lanes<I: Isa>(center: [R8<I>; 3], radius: R8<I>, ray: &SphereRay<I>, t_max: R8<I>) -> (u32, R8<I>) {
     let splat = R8::<I>::splat;
     let zero = splat(0.0);
-    if !ray.moving {
-        return (0, zero);
-    }
     let [dx, dy, dz] = ray.direction;
-    let ox = ray.origin[0] - R8::<I>::load(&pack.center[0]);
-    let oy = ray.origin[1] - R8::<I>::load(&pack.center[1]);
-    let oz = ray.origin[2] - R8::<I>::load(&pack.center[2]);
-    let radius = R8::<I>::load(&pack.radius);
+    let ox = ray.origin[0] - center[0];
+    let oy = ray.origin[1] - center[1];
+    let oz = ray.origin[2] - center[2];
     let b = splat(2.0) * (dx * ox + dy * oy + dz * oz);
     let c = (ox * ox + oy * oy + oz * oz) - radius * radius;
     let along = b / ray.two_a;
@@ -172,11 +175,62 @@ pub fn intersect_spheres<I: Isa>(pack: &SpherePack, ray: &SphereRay<I>, t_max: R
     let t = R8::<I>::select(t0.gt(zero).and(t0.abs().lt(infinity)), t0, t1);
     let hit = t
         .gt(zero)
-        .and(t.le(splat(t_max)))
+        .and(t.le(t_max))
         .and(t.abs().lt(infinity))
         .and_not(discriminant.lt(zero))
-        .and_not(q.eq(zero));
-    (hit.bits() & pack.live, t)
+        .and_not(q.eq(zero))
+        .and_not(ray.still);
+    (hit.bits(), t)
+}
+
+/// [`Sphere::intersect`] on the lanes of `pack`: a bit per lane hit in `(0, t_max]`, and each
+/// lane's `t`.
+///
+/// A kernel: compile it only inside one (see `crate::simd`).
+#[inline(always)]
+pub fn intersect_spheres<I: Isa>(pack: &SpherePack, ray: &SphereRay<I>, t_max: Real) -> (u32, R8<I>) {
+    let center = [R8::<I>::load(&pack.center[0]), R8::<I>::load(&pack.center[1]), R8::<I>::load(&pack.center[2])];
+    let (hits, t) = intersect_lanes(center, R8::<I>::load(&pack.radius), ray, R8::<I>::splat(t_max));
+    (hits & pack.live, t)
+}
+
+impl Sphere {
+    /// [`Sphere::intersect`] for a ray per lane of `rays`, each with its own `t_max`.
+    ///
+    /// A kernel: compile it only inside one (see `crate::simd`).
+    #[inline(always)]
+    pub fn intersect_rays<I: Isa>(&self, rays: &SphereRay<I>, t_max: R8<I>) -> (u32, R8<I>) {
+        if self.radius <= 0.0 {
+            return (0, t_max);
+        }
+        let c = V3::<I>::splat(self.center);
+        intersect_lanes([c.x, c.y, c.z], R8::<I>::splat(self.radius), rays, t_max)
+    }
+
+    /// [`Sphere::surface`] for a ray per lane, each lane's sphere given by its centre and radius.
+    #[inline(always)]
+    pub fn surface_lanes<I: Isa>(center: V3<I>, radius: R8<I>, rays: &RayLanes<I>, t: R8<I>) -> SurfaceLanes<I> {
+        let along = rays.at(t) - center;
+        let length = along.length();
+        let normal = V3::select(length.gt(R8::<I>::splat(0.0)), along.divide(length), V3::splat(Vec3::Y));
+        let relative = normal.scale(radius);
+        let point = center + relative;
+        let point_error = relative.abs().scale(R8::<I>::splat(gamma(5))) + point.abs().scale(R8::<I>::splat(gamma(1)));
+        SurfaceLanes { t, point, point_error, geometric_normal: normal, shading_normal: normal }
+    }
+}
+
+impl SpherePack {
+    /// The sphere in `lane`.
+    pub fn sphere(&self, lane: usize) -> Sphere {
+        let center = Vec3::new(self.center[0][lane], self.center[1][lane], self.center[2][lane]);
+        Sphere { center, radius: self.radius[lane] }
+    }
+
+    /// Bit per lane holding a sphere that can be hit.
+    pub fn live(&self) -> u32 {
+        self.live
+    }
 }
 
 #[cfg(test)]

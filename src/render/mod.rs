@@ -3,6 +3,7 @@
 
 mod faults;
 mod moments;
+mod packet;
 pub mod integrator;
 pub mod renderer;
 pub mod sampler;

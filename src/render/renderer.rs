@@ -4,8 +4,10 @@
 use rayon::prelude::*;
 
 use super::faults;
+use super::geometry::lanes::LANES;
 use super::integrator::Whitted;
-use super::real::{Real, Vec2, to_f32};
+use super::packet::WhittedLanes;
+use super::real::{Color, Real, Vec2, Vec3, to_f32};
 use super::sampler::Sampler;
 use super::scene::{Intersection, Scene};
 use crate::fault::{FaultPolicy, FaultSet, NoFaults};
@@ -22,9 +24,39 @@ const BAND_ROWS: usize = 4;
 /// The [1 2 1]⊗[1 2 1]/16 kernel over each output pixel's 3×3 block of supersamples.
 const GAUSSIAN_WEIGHTS: [Real; 3] = [0.25, 0.5, 0.25];
 
+/// The 3×3 supersamples of an output pixel, row by row: their column and row in the block and
+/// their weight (`wx·wy`, as the kernel's product rounds).
+const GAUSSIAN_SUBPIXELS: [(u32, u32, Real); 9] = {
+    let w = GAUSSIAN_WEIGHTS;
+    [
+        (0, 0, w[0] * w[0]),
+        (1, 0, w[1] * w[0]),
+        (2, 0, w[2] * w[0]),
+        (0, 1, w[0] * w[1]),
+        (1, 1, w[1] * w[1]),
+        (2, 1, w[2] * w[1]),
+        (0, 2, w[0] * w[2]),
+        (1, 2, w[1] * w[2]),
+        (2, 2, w[2] * w[2]),
+    ]
+};
+
 /// Renders the scene without counting anything.
 pub fn render(scene: &Scene, options: &RenderOptions, progress: &dyn Progress) -> Film {
     render_counted::<NoCount, _>(scene, options, NoFaults, progress).0
+}
+
+/// [`render`] with every ray traced alone, as the integrator's faults must be: the reference
+/// that the eight-lane integrator is checked against, bit for bit.
+#[cfg(test)]
+pub(super) fn render_one_ray_at_a_time(scene: &Scene, options: &RenderOptions) -> Film {
+    let sampler = Sampler::with_seeding(options.trace.samples, options.trace.seed, options.seeding);
+    let progress = &crate::progress::Silent;
+    if sampler.samples_per_pixel() > 1 {
+        render_pixels::<NoCount, _, WithVariance>(scene, options, sampler, NoFaults, false, progress).0
+    } else {
+        render_pixels::<NoCount, _, MeanOnly>(scene, options, sampler, NoFaults, false, progress).0
+    }
 }
 
 /// [`render`], also counting every ray traced, by kind (for `--stats`). The film is the same.
@@ -58,26 +90,31 @@ fn render_counted<C: RayCounter, F: FaultPolicy>(
 ) -> (Film, C) {
     let sampler = Sampler::with_seeding(options.trace.samples, options.trace.seed, options.seeding);
     if sampler.samples_per_pixel() > 1 {
-        render_pixels::<C, F, WithVariance>(scene, options, sampler, faults, progress)
+        render_pixels::<C, F, WithVariance>(scene, options, sampler, faults, true, progress)
     } else {
-        render_pixels::<C, F, MeanOnly>(scene, options, sampler, faults, progress)
+        render_pixels::<C, F, MeanOnly>(scene, options, sampler, faults, true, progress)
     }
 }
 
 /// [`render_counted`] with the choice of moments made once per render: `M` is [`WithVariance`]
 /// when a pixel has several samples, [`MeanOnly`] otherwise, so a one-sample render neither
-/// squares a sample nor allocates a variance plane.
+/// squares a sample nor allocates a variance plane. Rays are traced eight at a time when
+/// `in_lanes` and no integrator fault asks for them one by one.
 fn render_pixels<C: RayCounter, F: FaultPolicy, M: Moments>(
     scene: &Scene,
     options: &RenderOptions,
     sampler: Sampler,
     faults: F,
+    in_lanes: bool,
     progress: &dyn Progress,
 ) -> (Film, C) {
     let mut film = Film::new(options.trace.width, options.trace.height);
+    let trace = &options.trace;
     let pixels = PixelRenderer {
         scene,
-        integrator: Whitted::with_faults(scene, options.trace.bounces, options.trace.shadows, options.spawn, faults),
+        integrator: Whitted::with_faults(scene, trace.bounces, trace.shadows, options.spawn, faults),
+        lanes: (in_lanes && !faults.set().checks_integrator())
+            .then(|| WhittedLanes::new(scene, trace.bounces, trace.shadows, options.spawn)),
         faults,
         sampler,
         options,
@@ -93,18 +130,45 @@ fn render_pixels<C: RayCounter, F: FaultPolicy, M: Moments>(
         .map(|(band_index, ((color, depth), normal))| {
             let mut counter = C::default();
             let mut variance = M::band(color.len());
-            for (offset, ((color, depth), normal)) in color.iter_mut().zip(depth).zip(normal).enumerate() {
-                let index = band_index * band + offset;
-                let (x, y) = ((index % width) as u32, (index / width) as u32);
-                let mut rays = RayCounts::default();
-                let pixel = pixels.pixel::<M>(x, y, &mut rays);
-                counter.add(&rays);
-                *color = film_vector(pixel.color.mean());
-                *depth = pixel.depth;
-                *normal = pixel.normal;
+            let pixel_count = color.len();
+            let mut store = |offset: usize, pixel: Pixel<M>| {
+                color[offset] = film_vector(pixel.color.mean());
+                depth[offset] = pixel.depth;
+                normal[offset] = pixel.normal;
                 M::store(&mut variance, offset, &pixel.color);
+            };
+            let first = band_index * band;
+            match pixels.runs() {
+                Some(lanes) => {
+                    let (width, height) = (options.trace.width, options.trace.height);
+                    for start in (0..pixel_count).step_by(LANES) {
+                        let end = (start + LANES).min(pixel_count);
+                        let mut rays = RayCounts::default();
+                        let mut centres = [Vec2::ZERO; LANES];
+                        for (centre, index) in centres.iter_mut().zip(first + start..first + end) {
+                            *centre = pixel_centre((index % width as usize) as u32, (index / width as usize) as u32);
+                        }
+                        rays.camera += (end - start) as u64;
+                        let traced = lanes.trace(&centres[..end - start], width, height, &mut rays);
+                        counter.add(&rays);
+                        for (k, offset) in (start..end).enumerate() {
+                            let first = traced.first[k].filter(|_| options.aovs);
+                            store(offset, Pixel::new(M::single(traced.color[k]), first));
+                        }
+                    }
+                }
+                None => {
+                    for offset in 0..pixel_count {
+                        let index = first + offset;
+                        let (x, y) = ((index % width) as u32, (index / width) as u32);
+                        let mut rays = RayCounts::default();
+                        let pixel = pixels.pixel::<M>(x, y, &mut rays);
+                        counter.add(&rays);
+                        store(offset, pixel);
+                    }
+                }
             }
-            progress.advance((color.len() / width) as u64);
+            progress.advance((pixel_count / width) as u64);
             (counter, variance)
         })
         .collect();
@@ -127,52 +191,93 @@ struct Pixel<M> {
 struct PixelRenderer<'a, F: FaultPolicy> {
     scene: &'a Scene,
     integrator: Whitted<'a, F>,
+    /// The same integrator eight rays at a time, for every render without the integrator's
+    /// faults: it draws the same picture, bit for bit.
+    lanes: Option<WhittedLanes<'a>>,
     faults: F,
     sampler: Sampler,
     options: &'a RenderOptions,
 }
 
 impl<F: FaultPolicy> PixelRenderer<'_, F> {
+    /// The integrator for runs of eight pixels side by side, when pixels are one sample each
+    /// and the eight-lane integrator can draw them.
+    fn runs(&self) -> Option<&WhittedLanes<'_>> {
+        let single = self.options.trace.filter == Filter::None && self.sampler.samples_per_pixel() == 1;
+        self.lanes.as_ref().filter(|_| single)
+    }
+
     /// The pixel's colour (with its moments `M`) and AOVs; every ray traced for it is added to
     /// `rays`.
     fn pixel<M: Moments>(&self, x: u32, y: u32, rays: &mut RayCounts) -> Pixel<M> {
         let (width, height) = (self.options.trace.width, self.options.trace.height);
-        let centre = Vec2::new(x as Real + 0.5, y as Real + 0.5);
-        match self.options.trace.filter {
+        let centre = pixel_centre(x, y);
+        let subpixels: &[(u32, u32, Real)] = match self.options.trace.filter {
             Filter::None if self.sampler.samples_per_pixel() == 1 => {
                 rays.camera += 1;
-                let (color, first) = self.integrator.trace(self.scene.camera.ray(centre, width, height), rays);
-                Pixel::new(M::single(color), first.filter(|_| self.options.aovs).as_ref())
+                let ray = self.scene.camera.ray(centre, width, height);
+                let (color, first) = self.integrator.trace(ray, rays);
+                let first = first.filter(|_| self.options.aovs).map(|hit| (hit.surface.t, hit.surface.shading_normal));
+                return Pixel::new(M::single(color), first);
             }
-            Filter::None => {
-                let color = self.samples::<M>(x, y, width, height, rays);
-                Pixel::new(color, self.first_hit(centre, rays).as_ref())
-            }
-            Filter::Gaussian => {
-                let mut color = M::zero();
-                for (j, wy) in GAUSSIAN_WEIGHTS.iter().enumerate() {
-                    for (i, wx) in GAUSSIAN_WEIGHTS.iter().enumerate() {
-                        let sub = self.samples::<M>(3 * x + i as u32, 3 * y + j as u32, 3 * width, 3 * height, rays);
-                        color.add_weighted(&sub, wx * wy);
-                    }
+            Filter::None => &[(0, 0, 1.0)],
+            Filter::Gaussian => &GAUSSIAN_SUBPIXELS,
+        };
+        let scale = if self.options.trace.filter == Filter::Gaussian { 3 } else { 1 };
+        let mut color = M::zero();
+        let count = self.sampler.samples_per_pixel();
+        let mut moments = M::Accumulator::default();
+        let size = (scale * width, scale * height);
+        self.trace_samples(subpixels.len() as u32 * count, size, rays, |index| {
+            let (i, j, _) = subpixels[(index / count) as usize];
+            let (sx, sy) = (scale * x + i, scale * y + j);
+            Vec2::new(sx as Real, sy as Real) + self.sampler.offset(sx, sy, index % count)
+        }, |index, sample| {
+            M::push(&mut moments, sample);
+            if index % count == count - 1 {
+                let (_, _, weight) = subpixels[(index / count) as usize];
+                let sub = M::of(std::mem::take(&mut moments), count);
+                if scale == 1 {
+                    color = sub;
+                } else {
+                    color.add_weighted(&sub, weight);
                 }
-                Pixel::new(color, self.first_hit(centre, rays).as_ref())
             }
-        }
+        });
+        let first = self.first_hit(centre, rays).map(|hit| (hit.surface.t, hit.surface.shading_normal));
+        Pixel::new(color, first)
     }
 
-    /// Mean colour of a (sub)pixel's stratified samples in an image of `width × height`, with
-    /// the variance of that mean when `M` keeps it.
-    fn samples<M: Moments>(&self, x: u32, y: u32, width: u32, height: u32, rays: &mut RayCounts) -> M {
-        let count = self.sampler.samples_per_pixel();
-        let origin = Vec2::new(x as Real, y as Real);
-        rays.camera += u64::from(count);
-        let mut moments = M::Accumulator::default();
-        for index in 0..count {
-            let raster = origin + self.sampler.offset(x, y, index);
-            M::push(&mut moments, self.integrator.trace(self.scene.camera.ray(raster, width, height), rays).0);
+    /// Traces the `total` camera rays through `raster(0..total)`, points of the raster of an
+    /// image of `size`, and hands each one's colour to `sample(index, colour)` in order: eight at
+    /// a time when the eight-lane integrator can draw them, one at a time otherwise.
+    fn trace_samples(
+        &self,
+        total: u32,
+        (width, height): (u32, u32),
+        rays: &mut RayCounts,
+        raster: impl Fn(u32) -> Vec2,
+        mut sample: impl FnMut(u32, Color),
+    ) {
+        rays.camera += u64::from(total);
+        let Some(lanes) = &self.lanes else {
+            for index in 0..total {
+                let ray = self.scene.camera.ray(raster(index), width, height);
+                sample(index, self.integrator.trace(ray, rays).0);
+            }
+            return;
+        };
+        let mut points = [Vec2::ZERO; LANES];
+        for start in (0..total).step_by(LANES) {
+            let count = (total - start).min(LANES as u32) as usize;
+            for (point, index) in points.iter_mut().zip(start..start + count as u32) {
+                *point = raster(index);
+            }
+            let traced = lanes.trace(&points[..count], width, height, rays);
+            for (index, color) in (start..).zip(&traced.color[..count]) {
+                sample(index, *color);
+            }
         }
-        M::of(moments, count)
     }
 
     /// The AOVs come from one ray through the output pixel's centre: depth and normals averaged
@@ -187,15 +292,21 @@ impl<F: FaultPolicy> PixelRenderer<'_, F> {
     }
 }
 
+/// The centre of pixel `(x, y)` on the raster.
+fn pixel_centre(x: u32, y: u32) -> Vec2 {
+    Vec2::new(x as Real + 0.5, y as Real + 0.5)
+}
+
 impl<M> Pixel<M> {
-    fn new(color: M, first: Option<&Intersection>) -> Pixel<M> {
+    /// A pixel of colour `color` whose AOVs show `first` (the `t` and shading normal of the
+    /// first hit), or a miss.
+    fn new(color: M, first: Option<(Real, Vec3)>) -> Pixel<M> {
         match first {
-            Some(hit) => Pixel {
-                color,
-                depth: to_f32(hit.surface.t),
-                normal: film_vector(hit.surface.shading_normal),
-            },
+            Some((t, normal)) => Pixel { color, depth: to_f32(t), normal: film_vector(normal) },
             None => Pixel { color, depth: f32::INFINITY, normal: [0.0; 3] },
         }
     }
 }
+
+#[cfg(test)]
+mod tests;

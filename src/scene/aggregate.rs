@@ -4,11 +4,15 @@
 use super::geometry::aabb::{Aabb, SlabRay};
 use super::geometry::bvh::{BoxSet, Bvh, LeafCost, Visit, VisitFn, WIDTH, traverse};
 use super::geometry::plane::{PLANE_LANES, Plane, PlanePack, intersect_planes};
-use super::geometry::sphere::{SPHERE_LANES, SphereRay, SpherePack, intersect_spheres};
+use super::geometry::sphere::{SPHERE_LANES, Sphere, SphereRay, SpherePack, intersect_spheres};
 use super::geometry::{Ray, SurfaceHit};
 use super::object::{Object, Shape, ShapeHit};
 use super::real::Real;
 use crate::simd::{Isa, Kernel, Lanes, dispatch};
+
+mod packet;
+
+pub use packet::HitLanes;
 
 /// Up to this many untransformed spheres are tested on every ray, side by side, which costs
 /// less than the box tests of a tree; more go into the tree with everything else.
@@ -145,7 +149,12 @@ impl Aggregate {
                 self.0.closest_lanes::<I>(self.1)
             }
         }
-        Some(match dispatch(Nearest(self, ray))? {
+        Some(self.intersection(ray, dispatch(Nearest(self, ray))?))
+    }
+
+    /// The full hit record of what [`Aggregate::closest_lanes`] found along `ray`.
+    fn intersection(&self, ray: &Ray, found: Found) -> Intersection {
+        match found {
             Found::Object(index, hit) => {
                 let object = &self.traced[index as usize];
                 Intersection { surface: object.surface(ray, &hit), material: object.material }
@@ -154,7 +163,7 @@ impl Aggregate {
                 let (plane, material) = &self.planes[index];
                 Intersection { surface: plane.surface(ray, t), material: *material }
             }
-        })
+        }
     }
 
     #[inline(always)]
@@ -190,6 +199,14 @@ impl Aggregate {
                 }
             }
         }
+        self.closest_rest::<I>(ray, &mut closest);
+        closest.found
+    }
+
+    /// Offers `closest` what the ray meets among the objects that are neither packed spheres
+    /// nor planes.
+    #[inline(always)]
+    fn closest_rest<I: Isa>(&self, ray: &Ray, closest: &mut Closest) {
         match &self.rest {
             Rest::Nothing => {}
             Rest::One { object, bounds } => {
@@ -227,7 +244,6 @@ impl Aggregate {
                 }));
             }
         }
-        closest.found
     }
 
     /// Whether anything blocks the ray before `t_max`; stops at the first blocker found.
@@ -254,6 +270,12 @@ impl Aggregate {
         if self.plane_packs.iter().any(|pack| intersect_planes::<I>(pack, ray, t_max).0 != 0) {
             return true;
         }
+        self.any_rest::<I>(ray, t_max)
+    }
+
+    /// Whether an object that is neither a packed sphere nor a plane blocks the ray before `t_max`.
+    #[inline(always)]
+    fn any_rest<I: Isa>(&self, ray: &Ray, t_max: Real) -> bool {
         match &self.rest {
             Rest::Nothing => false,
             Rest::One { object, bounds } => {

@@ -1,7 +1,9 @@
 //! Perspective cameras: the native one, and the course reference renderer's, quirks included.
 
 use super::geometry::Ray;
-use super::real::{Real, Vec2, Vec3};
+use super::geometry::lanes::{RayLanes, V3};
+use super::real::{R8, Real, Vec2, Vec3};
+use crate::simd::{Isa, Lanes};
 use crate::options::Profile;
 
 #[derive(Clone, Debug)]
@@ -62,6 +64,32 @@ impl Camera {
             }
         };
         Ray::new(self.center, direction)
+    }
+
+    /// [`Camera::ray`] for eight raster positions `(x, y)`, a ray per lane, with the same
+    /// operations in the same order.
+    ///
+    /// A kernel: compile it only inside one (see `crate::simd`).
+    #[inline(always)]
+    pub fn ray_lanes<I: Isa>(&self, x: R8<I>, y: R8<I>, width: u32, height: u32) -> RayLanes<I> {
+        let splat = R8::<I>::splat;
+        let (w, h) = (width as Real, height as Real);
+        let direction = match &self.model {
+            Model::Native { forward, right, up, tan_half_fov } => {
+                let x = (splat(2.0) * x / splat(w) - splat(1.0)) * splat(*tan_half_fov) * splat(w / h);
+                let y = (splat(1.0) - splat(2.0) * y / splat(h)) * splat(*tan_half_fov);
+                (V3::splat(*forward) + V3::splat(*right).scale(x) + V3::splat(*up).scale(y)).normalize()
+            }
+            Model::Mit6837 { direction, horizontal, up, distance } => {
+                let x = x - splat(0.5);
+                let y = (splat(h) - y) - splat(0.5);
+                let ndc_x = if width > 1 { splat(2.0) * x / splat(w - 1.0) - splat(1.0) } else { splat(0.0) };
+                let ndc_y = if height > 1 { splat(2.0) * y / splat(h - 1.0) - splat(1.0) } else { splat(0.0) };
+                (V3::splat(*direction * *distance) + V3::splat(*horizontal).scale(ndc_x) + V3::splat(*up).scale(ndc_y))
+                    .normalize()
+            }
+        };
+        RayLanes { origin: V3::splat(self.center), direction }
     }
 }
 

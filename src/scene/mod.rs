@@ -9,7 +9,7 @@ pub mod light;
 pub mod material;
 mod object;
 
-pub use aggregate::{Aggregate, Intersection};
+pub use aggregate::{Aggregate, HitLanes, Intersection};
 pub use build::{build_scene, build_scene_measured};
 pub use cube_map::{CubeMap, CubeMapError};
 pub use object::{Object, Shape, ShapeHit, Triangle};

@@ -1,0 +1,148 @@
+//! [`Aggregate`]'s queries for eight rays at once, a ray per SIMD lane: each sphere and plane is
+//! tested against all eight rays in one go, and the other objects ray by ray. Lane by lane the
+//! answer is exactly [`Aggregate::intersect`]'s and [`Aggregate::occluded`]'s for that ray
+//! alone: the same tests in the same arithmetic, and the same rule for ties (candidates are
+//! offered in the order of their ids, and a later one wins only when strictly nearer).
+
+use super::super::geometry::lanes::{LANES, RayLanes, SurfaceLanes, V3, lane, mask};
+use super::super::real::{R8, Vec3};
+use super::*;
+use crate::simd::MaskOps;
+
+/// What eight rays hit first.
+pub struct HitLanes<I: Isa> {
+    /// A bit per lane whose ray hit something; the other lanes' surfaces are meaningless.
+    pub hits: u32,
+    pub surface: SurfaceLanes<I>,
+    /// Each lane's material.
+    pub material: [u32; LANES],
+}
+
+/// Calls `f` with the index of every set bit of `bits`, lowest first.
+#[inline(always)]
+fn each_lane(mut bits: u32, mut f: impl FnMut(usize)) {
+    while bits != 0 {
+        f(bits.trailing_zeros() as usize);
+        bits &= bits - 1;
+    }
+}
+
+impl Aggregate {
+    /// [`Aggregate::intersect`] for each ray of `rays` whose bit is set in `active`.
+    ///
+    /// A kernel: compile it only inside one (see `crate::simd`).
+    #[inline(always)]
+    pub fn intersect_packet<I: Isa>(&self, rays: &RayLanes<I>, active: u32) -> HitLanes<I> {
+        let infinity = R8::<I>::splat(Real::INFINITY);
+        let mut nearest = infinity;
+        let mut ids = [u32::MAX; LANES];
+        let mut material = [0; LANES];
+        let (mut sphere_lanes, mut plane_lanes) = (0, 0);
+        let (mut center, mut radius) = (V3::<I>::splat(Vec3::ZERO), R8::<I>::splat(0.0));
+        if !self.spheres.is_empty() {
+            let sphere_rays = SphereRay::<I>::lanes(rays);
+            for pack in &self.spheres {
+                let mut live = pack.live();
+                while live != 0 {
+                    let k = live.trailing_zeros() as usize;
+                    live &= live - 1;
+                    let sphere = pack.sphere(k);
+                    let (hits, t) = sphere.intersect_rays::<I>(&sphere_rays, infinity);
+                    let nearer = hits & active & t.lt(nearest).bits();
+                    if nearer != 0 {
+                        let chosen = mask::<I>(nearer);
+                        nearest = R8::<I>::select(chosen, t, nearest);
+                        center = V3::select(chosen, V3::splat(sphere.center), center);
+                        radius = R8::<I>::select(chosen, R8::<I>::splat(sphere.radius), radius);
+                        sphere_lanes |= nearer;
+                        let id = pack.ids()[k];
+                        each_lane(nearer, |lane| (ids[lane], material[lane]) = (id, self.objects[id as usize].material));
+                    }
+                }
+            }
+        }
+        let (mut normal, mut offset, mut shading_normal) =
+            (V3::<I>::splat(Vec3::Y), R8::<I>::splat(0.0), V3::<I>::splat(Vec3::Y));
+        let plane_ids = self.objects.len() as u32;
+        for (index, (plane, plane_material)) in self.planes.iter().enumerate() {
+            let (hits, t) = plane.intersect_rays::<I>(rays, infinity);
+            let nearer = hits & active & t.lt(nearest).bits();
+            if nearer != 0 {
+                let chosen = mask::<I>(nearer);
+                nearest = R8::<I>::select(chosen, t, nearest);
+                normal = V3::select(chosen, V3::splat(plane.normal), normal);
+                offset = R8::<I>::select(chosen, R8::<I>::splat(plane.offset), offset);
+                shading_normal = V3::select(chosen, V3::splat(plane.shading_normal), shading_normal);
+                plane_lanes |= nearer;
+                sphere_lanes &= !nearer;
+                let id = plane_ids + index as u32;
+                each_lane(nearer, |lane| (ids[lane], material[lane]) = (id, *plane_material));
+            }
+        }
+        let mut surface = match (sphere_lanes != 0, plane_lanes != 0) {
+            (true, false) => Sphere::surface_lanes(center, radius, rays, nearest),
+            (false, true) => Plane::surface_lanes(normal, offset, shading_normal, rays, nearest),
+            _ => SurfaceLanes::select(
+                mask::<I>(plane_lanes),
+                &Plane::surface_lanes(normal, offset, shading_normal, rays, nearest),
+                &Sphere::surface_lanes(center, radius, rays, nearest),
+            ),
+        };
+        let mut hits = sphere_lanes | plane_lanes;
+        if !matches!(self.rest, Rest::Nothing) {
+            let scalar_rays = rays.rays();
+            let mut others = [None; LANES];
+            each_lane(active, |k| {
+                let mut closest = Closest { t: lane::<I>(nearest, k), id: ids[k], found: None };
+                self.closest_rest::<I>(&scalar_rays[k], &mut closest);
+                if let Some(found) = closest.found {
+                    let intersection = self.intersection(&scalar_rays[k], found);
+                    others[k] = Some(intersection.surface);
+                    material[k] = intersection.material;
+                    hits |= 1 << k;
+                }
+            });
+            if others.iter().any(Option::is_some) {
+                surface = surface.with_lanes(&others);
+            }
+        }
+        HitLanes { hits, surface, material }
+    }
+
+    /// [`Aggregate::occluded`] for each ray of `rays` whose bit is set in `active`, each with its
+    /// own `t_max`: a bit per blocked ray.
+    ///
+    /// A kernel: compile it only inside one (see `crate::simd`).
+    #[inline(always)]
+    pub fn occluded_packet<I: Isa>(&self, rays: &RayLanes<I>, t_max: R8<I>, active: u32) -> u32 {
+        let mut blocked = 0;
+        if !self.spheres.is_empty() {
+            let sphere_rays = SphereRay::<I>::lanes(rays);
+            for pack in &self.spheres {
+                let mut live = pack.live();
+                while live != 0 && blocked != active {
+                    let k = live.trailing_zeros() as usize;
+                    live &= live - 1;
+                    blocked |= pack.sphere(k).intersect_rays::<I>(&sphere_rays, t_max).0 & active;
+                }
+            }
+        }
+        for (plane, _) in &self.planes {
+            if blocked == active {
+                return blocked;
+            }
+            blocked |= plane.intersect_rays::<I>(rays, t_max).0 & active;
+        }
+        if !matches!(self.rest, Rest::Nothing) && blocked != active {
+            let scalar_rays = rays.rays();
+            let mut limits = [0.0; LANES];
+            t_max.store(&mut limits);
+            each_lane(active & !blocked, |k| {
+                if self.any_rest::<I>(&scalar_rays[k], limits[k]) {
+                    blocked |= 1 << k;
+                }
+            });
+        }
+        blocked
+    }
+}
