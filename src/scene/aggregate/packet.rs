@@ -18,13 +18,17 @@ pub struct HitLanes<I: Isa> {
     pub material: [u32; LANES],
 }
 
-/// Calls `f` with the index of every set bit of `bits`, lowest first.
-#[inline(always)]
-fn each_lane(mut bits: u32, mut f: impl FnMut(usize)) {
-    while bits != 0 {
-        f(bits.trailing_zeros() as usize);
-        bits &= bits - 1;
-    }
+/// The index of every set bit of `bits`, lowest first. A loop over these, not a closure per lane:
+/// a closure is compiled as a function of its own, without the instructions of the kernel that
+/// calls it, and the SIMD code inside it would then call each intrinsic as a function.
+fn set_lanes(mut bits: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (bits != 0).then(|| {
+            let lane = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            lane
+        })
+    })
 }
 
 impl Aggregate {
@@ -56,7 +60,9 @@ impl Aggregate {
                         radius = R8::<I>::select(chosen, R8::<I>::splat(sphere.radius), radius);
                         sphere_lanes |= nearer;
                         let id = pack.ids()[k];
-                        each_lane(nearer, |lane| (ids[lane], material[lane]) = (id, self.objects[id as usize].material));
+                        for lane in set_lanes(nearer) {
+                            (ids[lane], material[lane]) = (id, self.objects[id as usize].material);
+                        }
                     }
                 }
             }
@@ -76,7 +82,9 @@ impl Aggregate {
                 plane_lanes |= nearer;
                 sphere_lanes &= !nearer;
                 let id = plane_ids + index as u32;
-                each_lane(nearer, |lane| (ids[lane], material[lane]) = (id, *plane_material));
+                for lane in set_lanes(nearer) {
+                    (ids[lane], material[lane]) = (id, *plane_material);
+                }
             }
         }
         let mut surface = match (sphere_lanes != 0, plane_lanes != 0) {
@@ -92,7 +100,7 @@ impl Aggregate {
         if !matches!(self.rest, Rest::Nothing) {
             let scalar_rays = rays.rays();
             let mut others = [None; LANES];
-            each_lane(active, |k| {
+            for k in set_lanes(active) {
                 let mut closest = Closest { t: lane::<I>(nearest, k), id: ids[k], found: None };
                 self.closest_rest::<I>(&scalar_rays[k], &mut closest);
                 if let Some(found) = closest.found {
@@ -101,7 +109,7 @@ impl Aggregate {
                     material[k] = intersection.material;
                     hits |= 1 << k;
                 }
-            });
+            }
             if others.iter().any(Option::is_some) {
                 surface = surface.with_lanes(&others);
             }
@@ -137,11 +145,11 @@ impl Aggregate {
             let scalar_rays = rays.rays();
             let mut limits = [0.0; LANES];
             t_max.store(&mut limits);
-            each_lane(active & !blocked, |k| {
+            for k in set_lanes(active & !blocked) {
                 if self.any_rest::<I>(&scalar_rays[k], limits[k]) {
                     blocked |= 1 << k;
                 }
-            });
+            }
         }
         blocked
     }
