@@ -35,16 +35,27 @@ impl<I: Isa> Clone for V3<I> {
 
 impl<I: Isa> Copy for V3<I> {}
 
+/// For each 8-bit set of lanes, 1 in the lanes of the set and 0 elsewhere.
+const FLAGS: [[Real; LANES]; 1 << LANES] = {
+    let mut flags = [[0.0; LANES]; 1 << LANES];
+    let mut bits = 0;
+    while bits < 1 << LANES {
+        let mut lane = 0;
+        while lane < LANES {
+            if bits & (1 << lane) != 0 {
+                flags[bits][lane] = 1.0;
+            }
+            lane += 1;
+        }
+        bits += 1;
+    }
+    flags
+};
+
 /// The lanes whose bit is set in `bits`, as a mask for [`Lanes::select`].
 #[inline(always)]
 pub fn mask<I: Isa>(bits: u32) -> Mask<I> {
-    let mut flags = [0.0; LANES];
-    for (lane, flag) in flags.iter_mut().enumerate() {
-        if bits & (1 << lane) != 0 {
-            *flag = 1.0;
-        }
-    }
-    R8::<I>::load(&flags).gt(R8::<I>::splat(0.0))
+    R8::<I>::load(&FLAGS[(bits & 0xff) as usize]).gt(R8::<I>::splat(0.0))
 }
 
 /// Lane `lane` of `value`.

@@ -21,7 +21,8 @@ use crate::stats::RayCounts;
 /// What up to eight primary rays saw.
 pub struct Traced {
     pub color: [Color; LANES],
-    /// What each primary ray hit first (its `t` and shading normal), for the AOVs.
+    /// What each primary ray hit first (its `t` and shading normal), for the AOVs; all `None`
+    /// unless asked for.
     pub first: [Option<(Real, Vec3)>; LANES],
 }
 
@@ -60,15 +61,15 @@ impl<'a> WhittedLanes<'a> {
     }
 
     /// The colour seen along the camera rays through one to eight points of the raster of an
-    /// image of `width × height`, and what each ray hit first. The caller counts the camera
-    /// rays; the shadow and reflection rays are added to `rays`.
-    pub fn trace(&self, raster: &[Vec2], width: u32, height: u32, rays: &mut RayCounts) -> Traced {
-        struct Trace<'a, 'b>(&'a WhittedLanes<'a>, &'b [Vec2], (u32, u32), &'b mut RayCounts);
+    /// image of `width × height`, and, when `first_hits`, what each ray hit first. The caller
+    /// counts the camera rays; the shadow and reflection rays are added to `rays`.
+    pub fn trace(&self, raster: &[Vec2], (width, height): (u32, u32), first_hits: bool, rays: &mut RayCounts) -> Traced {
+        struct Trace<'a, 'b>(&'a WhittedLanes<'a>, &'b [Vec2], (u32, u32), bool, &'b mut RayCounts);
         impl Kernel for Trace<'_, '_> {
             type Output = Traced;
             #[inline(always)]
             fn run<I: Isa>(self) -> Traced {
-                let (lanes, raster, (width, height), rays) = (self.0, self.1, self.2, self.3);
+                let (lanes, raster, (width, height), first_hits, rays) = (self.0, self.1, self.2, self.3, self.4);
                 let mut axes = [[0.0; LANES]; 2];
                 for lane in 0..LANES {
                     let point = raster[lane.min(raster.len() - 1)];
@@ -76,16 +77,16 @@ impl<'a> WhittedLanes<'a> {
                 }
                 let (x, y) = (R8::<I>::load(&axes[0]), R8::<I>::load(&axes[1]));
                 let primaries = lanes.scene.camera.ray_lanes::<I>(x, y, width, height);
-                lanes.trace_lanes::<I>(primaries, raster.len(), rays)
+                lanes.trace_lanes::<I>(primaries, raster.len(), first_hits, rays)
             }
         }
         debug_assert!((1..=LANES).contains(&raster.len()));
-        dispatch(Trace(self, raster, (width, height), rays))
+        dispatch(Trace(self, raster, (width, height), first_hits, rays))
     }
 
     /// The first `count` lanes of `rays` traced.
     #[inline(always)]
-    fn trace_lanes<I: Isa>(&self, mut rays: RayLanes<I>, count: usize, counts: &mut RayCounts) -> Traced {
+    fn trace_lanes<I: Isa>(&self, mut rays: RayLanes<I>, count: usize, first_hits: bool, counts: &mut RayCounts) -> Traced {
         let mut active = (1u32 << count) - 1;
         let mut color = V3::<I>::splat(Color::ZERO);
         let mut throughput = V3::<I>::splat(Color::ONE);
@@ -98,7 +99,7 @@ impl<'a> WhittedLanes<'a> {
                 color = V3::select(mask::<I>(missed), color + seen, color);
             }
             active &= hit.hits;
-            if depth == 0 {
+            if depth == 0 && first_hits {
                 let (normals, surface) = (hit.surface.shading_normal.vectors(), &hit.surface);
                 for (k, first) in first.iter_mut().enumerate().filter(|(k, _)| active & (1 << k) != 0) {
                     *first = Some((lane::<I>(surface.t, k), normals[k]));

@@ -149,11 +149,10 @@ fn render_pixels<C: RayCounter, F: FaultPolicy, M: Moments>(
                             *centre = pixel_centre((index % width as usize) as u32, (index / width as usize) as u32);
                         }
                         rays.camera += (end - start) as u64;
-                        let traced = lanes.trace(&centres[..end - start], width, height, &mut rays);
+                        let traced = lanes.trace(&centres[..end - start], (width, height), options.aovs, &mut rays);
                         counter.add(&rays);
                         for (k, offset) in (start..end).enumerate() {
-                            let first = traced.first[k].filter(|_| options.aovs);
-                            store(offset, Pixel::new(M::single(traced.color[k]), first));
+                            store(offset, Pixel::new(M::single(traced.color[k]), traced.first[k]));
                         }
                     }
                 }
@@ -228,54 +227,63 @@ impl<F: FaultPolicy> PixelRenderer<'_, F> {
         let count = self.sampler.samples_per_pixel();
         let mut moments = M::Accumulator::default();
         let size = (scale * width, scale * height);
-        self.trace_samples(subpixels.len() as u32 * count, size, rays, |index| {
-            let (i, j, _) = subpixels[(index / count) as usize];
-            let (sx, sy) = (scale * x + i, scale * y + j);
-            Vec2::new(sx as Real, sy as Real) + self.sampler.offset(sx, sy, index % count)
-        }, |index, sample| {
+        // The samples in order: sub-pixel by sub-pixel, each sub-pixel's `count` samples.
+        let (mut made, mut pixel, mut sub_origin) = (0, self.sampler.pixel(0, 0), Vec2::ZERO);
+        let (mut taken, mut sub) = (0, 0);
+        self.trace_samples(subpixels.len() as u32 * count, size, rays, || {
+            if made % count == 0 {
+                let (i, j, _) = subpixels[(made / count) as usize];
+                let (sx, sy) = (scale * x + i, scale * y + j);
+                (pixel, sub_origin) = (self.sampler.pixel(sx, sy), Vec2::new(sx as Real, sy as Real));
+            }
+            made += 1;
+            sub_origin + pixel.offset((made - 1) % count)
+        }, |sample| {
             M::push(&mut moments, sample);
-            if index % count == count - 1 {
-                let (_, _, weight) = subpixels[(index / count) as usize];
-                let sub = M::of(std::mem::take(&mut moments), count);
+            taken += 1;
+            if taken == count {
+                let finished = M::of(std::mem::take(&mut moments), count);
                 if scale == 1 {
-                    color = sub;
+                    color = finished;
                 } else {
-                    color.add_weighted(&sub, weight);
+                    color.add_weighted(&finished, subpixels[sub].2);
                 }
+                (taken, sub) = (0, sub + 1);
             }
         });
         let first = self.first_hit(centre, rays).map(|hit| (hit.surface.t, hit.surface.shading_normal));
         Pixel::new(color, first)
     }
 
-    /// Traces the `total` camera rays through `raster(0..total)`, points of the raster of an
-    /// image of `size`, and hands each one's colour to `sample(index, colour)` in order: eight at
-    /// a time when the eight-lane integrator can draw them, one at a time otherwise.
+    /// Traces `total` camera rays through the points `raster()` returns one after another, on
+    /// the raster of an image of `size`, and hands each one's colour to `sample(colour)` in the
+    /// same order: eight at a time when the eight-lane integrator can draw them, one at a time
+    /// otherwise.
     fn trace_samples(
         &self,
         total: u32,
         (width, height): (u32, u32),
         rays: &mut RayCounts,
-        raster: impl Fn(u32) -> Vec2,
-        mut sample: impl FnMut(u32, Color),
+        mut raster: impl FnMut() -> Vec2,
+        mut sample: impl FnMut(Color),
     ) {
         rays.camera += u64::from(total);
         let Some(lanes) = &self.lanes else {
-            for index in 0..total {
-                let ray = self.scene.camera.ray(raster(index), width, height);
-                sample(index, self.integrator.trace(ray, rays).0);
+            for _ in 0..total {
+                let ray = self.scene.camera.ray(raster(), width, height);
+                sample(self.integrator.trace(ray, rays).0);
             }
             return;
         };
         let mut points = [Vec2::ZERO; LANES];
         for start in (0..total).step_by(LANES) {
             let count = (total - start).min(LANES as u32) as usize;
-            for (point, index) in points.iter_mut().zip(start..start + count as u32) {
-                *point = raster(index);
+            for point in &mut points[..count] {
+                *point = raster();
             }
-            let traced = lanes.trace(&points[..count], width, height, rays);
-            for (index, color) in (start..).zip(&traced.color[..count]) {
-                sample(index, *color);
+            let traced = lanes.trace(&points[..count], (width, height), false, rays);
+            for color in &traced.color[..count] {
+                sample(*color);
             }
         }
     }
