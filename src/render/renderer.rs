@@ -230,7 +230,7 @@ impl<F: FaultPolicy> PixelRenderer<'_, F> {
         // The samples in order: sub-pixel by sub-pixel, each sub-pixel's `count` samples.
         let (mut made, mut pixel, mut sub_origin) = (0, self.sampler.pixel(0, 0), Vec2::ZERO);
         let (mut taken, mut sub) = (0, 0);
-        self.trace_samples(subpixels.len() as u32 * count, size, rays, || {
+        self.trace_samples(subpixels.len() as u32 * count, size, rays, #[inline(always)] || {
             if made % count == 0 {
                 let (i, j, _) = subpixels[(made / count) as usize];
                 let (sx, sy) = (scale * x + i, scale * y + j);
@@ -238,7 +238,7 @@ impl<F: FaultPolicy> PixelRenderer<'_, F> {
             }
             made += 1;
             sub_origin + pixel.offset((made - 1) % count)
-        }, |sample| {
+        }, #[inline(always)] |sample| {
             M::push(&mut moments, sample);
             taken += 1;
             if taken == count {
