@@ -8,7 +8,9 @@
 //! tree, so the wide tree is as deterministic as the binary one.
 
 use super::build::BinaryNode;
-use super::{BvhNode, WIDTH};
+use super::node::{BvhNode, Child};
+use super::WIDTH;
+use super::super::aabb::Aabb;
 use super::super::huge_page_vec;
 use super::super::real::Real;
 
@@ -26,12 +28,14 @@ pub(super) fn collapse(binary: &[BinaryNode]) -> Vec<BvhNode> {
 fn emit(binary: &[BinaryNode], index: usize, nodes: &mut Vec<BvhNode>) -> u32 {
     let (slots, len) = children(binary, index);
     let at = nodes.len();
-    nodes.push(BvhNode::EMPTY);
-    for (lane, &child) in slots[..len].iter().enumerate() {
-        let node = &binary[child];
-        let target = if node.is_leaf() { node.offset } else { emit(binary, child, nodes) };
-        nodes[at].set_child(lane, &node.bounds, target, node.prim_count);
+    nodes.push(BvhNode::new(&[]));
+    let mut children = [Child { bounds: Aabb::EMPTY, index: 0, count: 0 }; WIDTH];
+    for (child, &slot) in children.iter_mut().zip(&slots[..len]) {
+        let node = &binary[slot];
+        let target = if node.is_leaf() { node.offset } else { emit(binary, slot, nodes) };
+        *child = Child { bounds: node.bounds, index: target, count: node.prim_count };
     }
+    nodes[at] = BvhNode::new(&children[..len]);
     at as u32
 }
 
