@@ -80,27 +80,25 @@ impl BvhNode {
                 node.used |= 1 << lane;
             }
         }
-        for axis in 0..3 {
-            let mut bounds = [(0.0, 0.0); WIDTH];
-            let mut len = 0;
-            for (lane, child) in children.iter().enumerate() {
-                if node.used >> lane & 1 != 0 {
-                    bounds[len] = (child.bounds.min[axis], child.bounds.max[axis]);
-                    len += 1;
-                }
+        if node.used == 0 {
+            return node;
+        }
+        // By axis and lane; unused lanes copy a used one's bounds: their codes are never read.
+        let first_used = &children[node.used.trailing_zeros() as usize];
+        let (mut min, mut max) = ([[0.0; WIDTH]; 3], [[0.0; WIDTH]; 3]);
+        for lane in 0..WIDTH {
+            let source = if node.used >> lane & 1 != 0 { &children[lane] } else { first_used };
+            let (low, high) = (source.bounds.min.to_array(), source.bounds.max.to_array());
+            for axis in 0..3 {
+                (min[axis][lane], max[axis][lane]) = (low[axis], high[axis]);
             }
-            match quantise_axis(&bounds[..len]) {
-                Some((origin, scale, codes)) => {
+        }
+        for (axis, (min, max)) in min.iter().zip(&max).enumerate() {
+            match quantise_axis(min, max) {
+                Some((origin, scale, lower, upper)) => {
                     node.origin[axis] = origin;
                     node.scale[axis] = scale;
-                    let mut code = codes.iter();
-                    for lane in 0..children.len() {
-                        if node.used >> lane & 1 != 0 {
-                            let &(lower, upper) = code.next().expect("a code per used lane");
-                            node.planes[0][axis][lane] = lower;
-                            node.planes[1][axis][lane] = upper;
-                        }
-                    }
+                    (node.planes[0][axis], node.planes[1][axis]) = (lower, upper);
                 }
                 None => node.origin[axis] = Real::NAN,
             }
@@ -151,74 +149,56 @@ fn plane(origin: Real, scale: Real, code: u8) -> Real {
     code as Real * scale + origin
 }
 
-/// The origin, the scale and each child's `(lower, upper)` codes on one axis, given the
-/// children's `(min, max)` on it, with every lower plane at or below its bound and every upper
-/// plane at or above; `None` when the axis cannot be quantised (see the module's doc).
-fn quantise_axis(bounds: &[(Real, Real)]) -> Option<(Real, Real, [(u8, u8); WIDTH])> {
-    let low = bounds.iter().map(|b| b.0).fold(Real::INFINITY, Real::min);
-    let high = bounds.iter().map(|b| b.1).fold(Real::NEG_INFINITY, Real::max);
+/// The origin, the scale and each lane's lower and upper codes on one axis, given the lanes'
+/// `min` and `max` on it, with every lower plane at or below its bound and every upper plane at
+/// or above; `None` when the axis cannot be quantised (see the module's doc). Lane by lane
+/// without branches, so that it runs on all lanes at once: the build quantises every node.
+#[allow(clippy::type_complexity)]
+fn quantise_axis(min: &[Real; WIDTH], max: &[Real; WIDTH]) -> Option<(Real, Real, [u8; WIDTH], [u8; WIDTH])> {
+    let low = min.iter().copied().fold(Real::INFINITY, Real::min);
+    let high = max.iter().copied().fold(Real::NEG_INFINITY, Real::max);
     let extent = high - low;
     if !(low.is_finite() && high.is_finite() && extent.is_finite()) {
         return None;
     }
-    // The smallest power of two with 255 steps covering the extent; twice that when the
-    // rounding of the planes leaves an upper bound uncovered.
-    let mut scale = if extent > 0.0 { smallest_power_of_two_at_least(extent / TOP) } else { 0.0 };
-    'scales: loop {
-        let mut codes = [(0, 0); WIDTH];
-        for (code, &(min, max)) in codes.iter_mut().zip(bounds) {
-            let Some(upper) = upper_code(low, scale, max) else {
-                if !(scale * 2.0).is_finite() {
-                    return None;
-                }
-                scale *= 2.0;
-                continue 'scales;
-            };
-            *code = (lower_code(low, scale, min), upper);
+    // The smallest power of two with 255 steps covering the extent (at least the smallest
+    // subnormal, a power of two, when the division underflows); twice that when the rounding of
+    // the planes leaves an upper bound uncovered, and none when no finite one covers it.
+    let mut scale = if extent > 0.0 { smallest_power_of_two_at_least(extent / TOP).max(Real::from_bits(1)) } else { 0.0 };
+    while scale.is_finite() {
+        let (mut lower, mut upper) = ([0; WIDTH], [0; WIDTH]);
+        for lane in 0..WIDTH {
+            // The truncated quotient, one lower if the plane's rounding put it above; code 0
+            // (the origin's plane, at or below every bound) if even that is above.
+            let code = estimate(low, scale, min[lane]);
+            let code = code - (plane(low, scale, code) > min[lane]) as u8;
+            lower[lane] = if plane(low, scale, code) > min[lane] { 0 } else { code };
+            // The truncated quotient, one higher if its plane is below.
+            let code = estimate(low, scale, max[lane]);
+            upper[lane] = code.saturating_add((plane(low, scale, code) < max[lane]) as u8);
         }
-        return Some((low, scale, codes));
+        if (0..WIDTH).all(|lane| plane(low, scale, upper[lane]) >= max[lane]) {
+            return Some((low, scale, lower, upper));
+        }
+        scale *= 2.0;
     }
+    None
 }
 
-/// The largest code whose plane is at or below `bound` (code 0's plane is the origin, at or
-/// below every bound).
-fn lower_code(origin: Real, scale: Real, bound: Real) -> u8 {
-    let mut code = if scale > 0.0 { ((bound - origin) / scale).floor().clamp(0.0, TOP) as u8 } else { 0 };
-    while code > 0 && plane(origin, scale, code) > bound {
-        code -= 1;
-    }
-    while code < u8::MAX && plane(origin, scale, code + 1) <= bound {
-        code += 1;
-    }
-    code
+/// About `(bound − origin) / scale`, truncated and clamped to a code (an `as` conversion, not
+/// `floor`, which baseline x86-64 calls a library function for).
+#[inline]
+fn estimate(origin: Real, scale: Real, bound: Real) -> u8 {
+    // Never negative (the origin is the lowest bound); `as` saturates at 255 and takes NaN to 0.
+    if scale > 0.0 { ((bound - origin) / scale) as u8 } else { 0 }
 }
 
-/// The smallest code whose plane is at or above `bound`; `None` if even 255's is below.
-fn upper_code(origin: Real, scale: Real, bound: Real) -> Option<u8> {
-    let mut code = if scale > 0.0 { ((bound - origin) / scale).ceil().clamp(0.0, TOP) as u8 } else { 0 };
-    while code < u8::MAX && plane(origin, scale, code) < bound {
-        code += 1;
-    }
-    while code > 0 && plane(origin, scale, code - 1) >= bound {
-        code -= 1;
-    }
-    (plane(origin, scale, code) >= bound).then_some(code)
-}
-
-/// The smallest power of two at or above a positive finite `x` (the largest finite power of
-/// two if none is finite).
+/// The smallest power of two at or above a positive finite `x`, by its bits: a mantissa that is
+/// not zero is rounded up into the exponent (a subnormal `x` gives the smallest normal power,
+/// still at or above it; an `x` beyond the largest power gives infinity).
 fn smallest_power_of_two_at_least(x: Real) -> Real {
-    let mut power = x.log2().ceil().exp2();
-    if !power.is_finite() || power == 0.0 {
-        power = if x > 1.0 { Real::MAX.log2().floor().exp2() } else { Real::MIN_POSITIVE };
-    }
-    while power < x && (power * 2.0).is_finite() {
-        power *= 2.0;
-    }
-    while power / 2.0 >= x {
-        power /= 2.0;
-    }
-    power
+    let mantissa = (1 << (Real::MANTISSA_DIGITS - 1)) - 1;
+    Real::from_bits((x.to_bits() + mantissa) & !mantissa)
 }
 
 #[cfg(test)]
@@ -231,6 +211,7 @@ mod tests {
         prop_oneof![
             -1e3 as Real..1e3 as Real,
             -1e-3 as Real..1e-3 as Real,
+            -1e-37 as Real..1e-37 as Real,
             (1e6 as Real..1e7 as Real),
             Just(0.0 as Real),
         ]

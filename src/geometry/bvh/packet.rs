@@ -4,7 +4,7 @@ use super::super::Ray;
 use super::super::real::{R8, Real};
 use crate::simd::{Isa, Lanes, MaskOps};
 use super::*;
-use super::traverse::sort_key;
+use super::traverse::{Stack, sort_key};
 
 pub const PACKET: usize = 8;
 
@@ -72,6 +72,8 @@ struct PacketPending {
 /// shrink the rays' entries of `t_limit`, which prunes, ray by ray, every box entered beyond.
 ///
 /// A kernel: compile it only inside one (see `crate::simd`).
+// The slab test's loop over the axes indexes the planes and four of the packet's arrays.
+#[allow(clippy::needless_range_loop)]
 #[inline(always)]
 pub fn traverse_packet<I: Isa>(
     nodes: &[BvhNode],
@@ -83,7 +85,7 @@ pub fn traverse_packet<I: Isa>(
     if nodes.is_empty() || rays == 0 {
         return;
     }
-    let mut stack: Vec<PacketPending> = Vec::with_capacity(64);
+    let mut stack = Stack::<PacketPending>::new();
     let mut current = PacketPending { t: 0.0, index: 0, count: 0, rays };
     loop {
         if current.count == 0 {

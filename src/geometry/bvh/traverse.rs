@@ -101,28 +101,28 @@ pub(super) fn sort_key(t: Real, lane: usize) -> u64 {
 }
 
 /// The traversal stack: room for `STACK_SIZE` entries, the most any tree can need, and, unlike
-/// an array, not initialised (zeroing them for every ray would cost more than most rays push).
-/// A push never checks for room and a pop only for emptiness.
-struct Stack {
-    entries: [MaybeUninit<Pending>; STACK_SIZE],
+/// an array, not initialised (zeroing them for every ray would cost more than most rays push;
+/// a `Vec` would cost an allocation). A push never checks for room and a pop only for emptiness.
+pub(super) struct Stack<T> {
+    entries: [MaybeUninit<T>; STACK_SIZE],
     len: usize,
 }
 
-impl Stack {
+impl<T: Copy> Stack<T> {
     #[inline(always)]
-    fn new() -> Self {
+    pub(super) fn new() -> Self {
         Stack { entries: [const { MaybeUninit::uninit() }; STACK_SIZE], len: 0 }
     }
 
     #[inline(always)]
-    fn push(&mut self, entry: Pending) {
+    pub(super) fn push(&mut self, entry: T) {
         // In bounds: each node visited pushes at most `WIDTH - 1` entries (see `STACK_SIZE`).
         self.entries[self.len] = MaybeUninit::new(entry);
         self.len += 1;
     }
 
     #[inline(always)]
-    fn pop(&mut self) -> Option<Pending> {
+    pub(super) fn pop(&mut self) -> Option<T> {
         if self.len == 0 {
             return None;
         }
@@ -160,7 +160,7 @@ pub fn traverse<I: Isa>(nodes: &[BvhNode], ray: &Ray, t_max: Real, visitor: &mut
     }
     let slab = SlabLanes::<I>::new(ray);
     let mut t_limit = t_max;
-    let mut stack = Stack::new();
+    let mut stack = Stack::<Pending>::new();
     let mut current = Pending { t: 0.0, index: 0, count: 0 };
     loop {
         if current.count == 0 {
