@@ -1,5 +1,5 @@
 //! Integration tests of the geometry module: watertight triangles, BVH traversal and the packed
-//! (SIMD) mesh queries against brute force, mesh and OBJ loading, and the procedural blob. Shared helpers live here; the tests
+//! (SIMD) mesh queries against brute force (also where the tree's quantised boxes are tightest), mesh and OBJ loading, and the procedural blob. Shared helpers live here; the tests
 //! are split by topic into the files under `tests/geometry/`.
 
 #[path = "geometry/bvh.rs"]
@@ -10,6 +10,8 @@ mod generate;
 mod obj;
 #[path = "geometry/packs.rs"]
 mod packs;
+#[path = "geometry/quantised.rs"]
+mod quantised;
 #[path = "geometry/timing.rs"]
 mod timing;
 #[path = "geometry/watertight.rs"]

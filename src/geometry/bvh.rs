@@ -9,6 +9,7 @@
 mod box_set;
 mod build;
 mod collapse;
+mod node;
 mod packet;
 mod traverse;
 
@@ -20,6 +21,7 @@ use super::real::{MACHINE_EPSILON, Real, gamma};
 use crate::simd::{Isa, Kernel, dispatch};
 
 pub use box_set::BoxSet;
+pub use node::BvhNode;
 pub use build::LeafCost;
 pub use packet::{PACKET, PacketLanes, traverse_packet};
 pub use traverse::traverse;
@@ -41,46 +43,6 @@ const BOX_SLACK: Real = 1.0 + 64.0 * MACHINE_EPSILON;
 /// children (the nearest is visited next), which sizes the traversal stack so that it can never
 /// overflow.
 const STACK_SIZE: usize = (WIDTH - 1) * (build::SAH_DEPTH_LIMIT + 33) + 1;
-
-/// One node of the 8-wide tree: the boxes of its (up to eight) children side by side, one lane
-/// per child, so that one slab test covers all eight. 256 bytes with `f32` bounds, aligned to
-/// whole cache lines.
-///
-/// A child is either another node or a leaf, a run of primitives stored in the node itself.
-/// Unused slots have an empty box, which no ray enters.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[repr(C, align(64))]
-pub struct BvhNode {
-    /// `bounds[0]` holds the children's minimum corners, `bounds[1]` their maximum ones, by axis
-    /// and then lane.
-    bounds: [[[Real; WIDTH]; 3]; 2],
-    /// Interior child: its node's index. Leaf: the index of its first entry in the primitive order.
-    child: [u32; WIDTH],
-    /// Leaf: its number of primitives (at least one). Zero for an interior child or unused slot.
-    count: [u32; WIDTH],
-}
-
-impl BvhNode {
-    const EMPTY: BvhNode = BvhNode {
-        bounds: [[[Real::INFINITY; WIDTH]; 3], [[Real::NEG_INFINITY; WIDTH]; 3]],
-        child: [0; WIDTH],
-        count: [0; WIDTH],
-    };
-
-    fn set_child(&mut self, lane: usize, bounds: &Aabb, child: u32, count: u32) {
-        for axis in 0..3 {
-            self.bounds[0][axis][lane] = bounds.min[axis];
-            self.bounds[1][axis][lane] = bounds.max[axis];
-        }
-        self.child[lane] = child;
-        self.count[lane] = count;
-    }
-
-    /// Number of leaves among the children.
-    fn leaf_count(&self) -> usize {
-        self.count.iter().filter(|&&count| count > 0).count()
-    }
-}
 
 /// A child waiting on the traversal stack: `count == 0` for a node, else a leaf's run of
 /// primitives; `t` is where the ray enters its box, so that it is skipped once a hit nearer
@@ -186,7 +148,7 @@ impl Bvh {
         for node in &self.nodes {
             for lane in 0..WIDTH {
                 if node.count[lane] > 0 {
-                    count_at[node.child[lane] as usize] = node.count[lane];
+                    count_at[node.child[lane] as usize] = node.count[lane] as u32;
                 }
             }
         }
@@ -208,8 +170,9 @@ impl Bvh {
         for node in &mut self.nodes {
             for lane in 0..WIDTH {
                 if node.count[lane] > 0 {
-                    (node.child[lane], node.count[lane]) = remap(node.child[lane], node.count[lane]);
-                    debug_assert!(node.count[lane] > 0, "a leaf keeps at least one entry");
+                    let (first, count) = remap(node.child[lane], node.count[lane] as u32);
+                    assert!((1..=255).contains(&count), "a leaf keeps one to 255 entries, not {count}");
+                    (node.child[lane], node.count[lane]) = (first, count as u8);
                 }
             }
         }

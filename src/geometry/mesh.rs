@@ -280,11 +280,7 @@ fn pack_leaves(bvh: &mut Bvh, corners: &[[Vec3; 3]]) -> Vec<TrianglePack> {
         .flat_map_iter(|&(first, count)| {
             (first..first + count).step_by(4).map(move |start| {
                 let end = (start + 4).min(first + count);
-                let mut lanes = [(0, [Vec3::ZERO; 3]); 4];
-                for (lane, index) in (start..end).enumerate() {
-                    lanes[lane] = (index, corners[index as usize]);
-                }
-                TrianglePack::new(&lanes[..(end - start) as usize])
+                TrianglePack::new(start, &corners[start as usize..end as usize])
             })
         });
     packs.par_extend(all);

@@ -13,7 +13,7 @@ use super::{Rng, ray_through};
 
 /// The nearest hit over every triangle of the mesh, ties to the smaller index, as `Mesh` numbers
 /// its triangles.
-fn brute_force(mesh: &Mesh, ray: &Ray, t_max: Real) -> Option<MeshHit> {
+pub(super) fn brute_force(mesh: &Mesh, ray: &Ray, t_max: Real) -> Option<MeshHit> {
     let triangle_ray = TriangleRay::new(ray);
     let mut closest: Option<MeshHit> = None;
     for triangle in 0..mesh.triangle_count() as u32 {

@@ -5,14 +5,29 @@ use super::super::aabb::Aabb;
 use super::super::real::Real;
 use crate::simd::{Isa, Lanes};
 use super::*;
-use super::traverse::{SlabLanes, node_hits, sort_key};
+use super::super::real::R8;
+use super::traverse::{LaneBoxes, SlabLanes, node_hits, sort_key};
 
 /// Up to eight boxes side by side, tested at once with the traversal's slab test: a handful of
 /// objects that need no tree.
 #[derive(Clone, Debug)]
 pub struct BoxSet {
-    node: BvhNode,
+    /// `bounds[0]` holds the boxes' minimum corners, `bounds[1]` their maximum ones, by axis and
+    /// then lane; unused lanes hold the empty box, which no ray enters.
+    bounds: [[[Real; WIDTH]; 3]; 2],
     len: usize,
+}
+
+impl LaneBoxes for BoxSet {
+    #[inline(always)]
+    fn planes<I: Isa>(&self, side: usize, axis: usize) -> R8<I> {
+        R8::<I>::load(&self.bounds[side][axis])
+    }
+
+    #[inline(always)]
+    fn used(&self) -> u32 {
+        u32::MAX
+    }
 }
 
 impl BoxSet {
@@ -20,11 +35,17 @@ impl BoxSet {
     /// With more than [`WIDTH`] boxes.
     pub fn new(bounds: &[Aabb]) -> BoxSet {
         assert!(bounds.len() <= WIDTH, "a box set holds at most {WIDTH} boxes");
-        let mut node = BvhNode::EMPTY;
+        let mut set = BoxSet {
+            bounds: [[[Real::INFINITY; WIDTH]; 3], [[Real::NEG_INFINITY; WIDTH]; 3]],
+            len: bounds.len(),
+        };
         for (lane, bounds) in bounds.iter().enumerate() {
-            node.set_child(lane, bounds, lane as u32, 1);
+            for axis in 0..3 {
+                set.bounds[0][axis][lane] = bounds.min[axis];
+                set.bounds[1][axis][lane] = bounds.max[axis];
+            }
         }
-        BoxSet { node, len: bounds.len() }
+        set
     }
 
     pub fn len(&self) -> usize {
@@ -45,7 +66,7 @@ impl BoxSet {
         if !(ray.origin.is_finite() && ray.direction.is_finite()) {
             return (0, t);
         }
-        let (t_enter, hits) = node_hits::<I>(&self.node, &SlabLanes::<I>::new(ray), t_limit);
+        let (t_enter, hits) = node_hits::<I>(self, &SlabLanes::<I>::new(ray), t_limit);
         t_enter.store(&mut t);
         (hits, t)
     }

@@ -8,29 +8,41 @@
 //! tree, so the wide tree is as deterministic as the binary one.
 
 use super::build::BinaryNode;
-use super::{BvhNode, WIDTH};
+use super::node::{BvhNode, Child};
+use super::WIDTH;
+use super::super::aabb::Aabb;
 use super::super::huge_page_vec;
 use super::super::real::Real;
+use rayon::prelude::*;
 
 /// The wide nodes in depth-first order (a node's first interior child follows it), root first.
+///
+/// The tree is laid out first with each node's exact child boxes; the boxes are then
+/// quantised node by node in parallel (a node's quantisation depends on its children's boxes
+/// only, so the result is the same on any number of threads).
 pub(super) fn collapse(binary: &[BinaryNode]) -> Vec<BvhNode> {
-    let mut nodes = huge_page_vec(binary.len() / 2 + 1);
+    let mut layout = Vec::with_capacity(binary.len() / 2 + 1);
     if !binary.is_empty() {
-        emit(binary, 0, &mut nodes);
+        emit(binary, 0, &mut layout);
     }
+    let mut nodes = huge_page_vec(layout.len());
+    nodes.par_extend(layout.par_iter().map(|(children, len)| BvhNode::new(&children[..*len])));
     nodes
 }
 
+/// A wide node's children with their exact boxes, and how many there are.
+type Children = ([Child; WIDTH], usize);
+
 /// Appends the wide node standing for binary node `index` and then, depth first, the wide
 /// nodes of its interior children; returns the node's index.
-fn emit(binary: &[BinaryNode], index: usize, nodes: &mut Vec<BvhNode>) -> u32 {
+fn emit(binary: &[BinaryNode], index: usize, layout: &mut Vec<Children>) -> u32 {
     let (slots, len) = children(binary, index);
-    let at = nodes.len();
-    nodes.push(BvhNode::EMPTY);
-    for (lane, &child) in slots[..len].iter().enumerate() {
-        let node = &binary[child];
-        let target = if node.is_leaf() { node.offset } else { emit(binary, child, nodes) };
-        nodes[at].set_child(lane, &node.bounds, target, node.prim_count);
+    let at = layout.len();
+    layout.push(([Child { bounds: Aabb::EMPTY, index: 0, count: 0 }; WIDTH], len));
+    for (lane, &slot) in slots[..len].iter().enumerate() {
+        let node = &binary[slot];
+        let target = if node.is_leaf() { node.offset } else { emit(binary, slot, layout) };
+        layout[at].0[lane] = Child { bounds: node.bounds, index: target, count: node.prim_count };
     }
     at as u32
 }

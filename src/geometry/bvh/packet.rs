@@ -4,7 +4,7 @@ use super::super::Ray;
 use super::super::real::{R8, Real};
 use crate::simd::{Isa, Lanes, MaskOps};
 use super::*;
-use super::traverse::sort_key;
+use super::traverse::{Stack, sort_key};
 
 pub const PACKET: usize = 8;
 
@@ -72,6 +72,8 @@ struct PacketPending {
 /// shrink the rays' entries of `t_limit`, which prunes, ray by ray, every box entered beyond.
 ///
 /// A kernel: compile it only inside one (see `crate::simd`).
+// The slab test's loop over the axes indexes the planes and four of the packet's arrays.
+#[allow(clippy::needless_range_loop)]
 #[inline(always)]
 pub fn traverse_packet<I: Isa>(
     nodes: &[BvhNode],
@@ -83,7 +85,7 @@ pub fn traverse_packet<I: Isa>(
     if nodes.is_empty() || rays == 0 {
         return;
     }
-    let mut stack: Vec<PacketPending> = Vec::with_capacity(64);
+    let mut stack = Stack::<PacketPending>::new();
     let mut current = PacketPending { t: 0.0, index: 0, count: 0, rays };
     loop {
         if current.count == 0 {
@@ -91,17 +93,23 @@ pub fn traverse_packet<I: Isa>(
             let limit = R8::<I>::load(&t_limit[..]) * R8::<I>::splat(BOX_SLACK);
             let mut children = [(0u64, 0u32); WIDTH];
             let mut hit = 0;
-            for slot in 0..WIDTH {
-                // The collapse fills slots from the first; the root is no node's child.
-                if node.child[slot] == 0 && node.count[slot] == 0 {
-                    break;
+            // The node's planes, as one ray's traversal computes them, then lane by lane.
+            let mut planes = [[[0.0; WIDTH]; 3]; 2];
+            for (side, planes) in planes.iter_mut().enumerate() {
+                for (axis, planes) in planes.iter_mut().enumerate() {
+                    node.planes::<I>(side, axis).store(planes);
                 }
+            }
+            let mut used = node.used();
+            while used != 0 {
+                let slot = used.trailing_zeros() as usize;
+                used &= used - 1;
                 let mut t_enter = R8::<I>::splat(0.0);
                 let mut t_exit = limit;
                 for axis in 0..3 {
                     let negative = lanes.negative[axis] as usize;
-                    let near = R8::<I>::splat(node.bounds[negative][axis][slot]);
-                    let far = R8::<I>::splat(node.bounds[1 - negative][axis][slot]);
+                    let near = R8::<I>::splat(planes[negative][axis][slot]);
+                    let far = R8::<I>::splat(planes[1 - negative][axis][slot]);
                     let t_near = (near - lanes.origin[axis]) * lanes.inverse[axis];
                     let t_far = (far - lanes.origin[axis]) * lanes.far_inverse[axis];
                     t_enter = t_near.max(t_enter);
@@ -142,7 +150,7 @@ pub fn traverse_packet<I: Isa>(
                 let pending = |(key, rays): (u64, u32)| {
                     let slot = key as usize & (WIDTH - 1);
                     let t = Real::from_bits_key(key);
-                    PacketPending { t, index: node.child[slot], count: node.count[slot], rays }
+                    PacketPending { t, index: node.child[slot], count: node.count[slot] as u32, rays }
                 };
                 for &child in children[1..hit].iter().rev() {
                     stack.push(pending(child));

@@ -35,8 +35,31 @@ impl<I: Isa> SlabLanes<I> {
     }
 }
 
-/// The slab test of a node's eight boxes: each box's entry distance, and a bit per box the ray
-/// meets for some `t` in `[0, t_limit·BOX_SLACK]`.
+/// Eight boxes side by side, one per lane, as the slab test reads them: a node's quantised
+/// boxes, or a [`BoxSet`]'s exact ones.
+pub(super) trait LaneBoxes {
+    /// The lanes' planes on `axis`: the minimum corners' when `side` is 0, the maximum ones'
+    /// when 1.
+    fn planes<I: Isa>(&self, side: usize, axis: usize) -> R8<I>;
+
+    /// A bit per lane that may be entered at all.
+    fn used(&self) -> u32;
+}
+
+impl LaneBoxes for BvhNode {
+    #[inline(always)]
+    fn planes<I: Isa>(&self, side: usize, axis: usize) -> R8<I> {
+        BvhNode::planes::<I>(self, side, axis)
+    }
+
+    #[inline(always)]
+    fn used(&self) -> u32 {
+        BvhNode::used(self)
+    }
+}
+
+/// The slab test of eight boxes: each box's entry distance, and a bit per box the ray meets for
+/// some `t` in `[0, t_limit·BOX_SLACK]`.
 ///
 /// Conservative: it may report a hit the exact test would not, but never misses a box the
 /// ray really touches, which is what keeps traversal from losing primitives. Two details
@@ -46,21 +69,24 @@ impl<I: Isa> SlabLanes<I> {
 /// `6u` of the widening (`(1 − u)⁴·(1 + 2·gamma(3)) > 1`). And a zero direction component
 /// gives an infinite inverse, so an origin lying exactly on that slab's plane computes
 /// `0 · ∞ = NaN`; `max`/`min` keep their second operand for a NaN, so that slab then constrains
-/// nothing, i.e. the plane counts as inside the box, as a closed box should. An empty box
-/// (`min = +∞`, `max = −∞`) is never hit: its far distance is `−∞` on every axis.
+/// nothing, i.e. the plane counts as inside the box, as a closed box should (and a NaN plane,
+/// a node's axis that is not quantised, constrains nothing either). An empty box (`min = +∞`,
+/// `max = −∞`) is never hit: its far distance is `−∞` on every axis. A node's quantised boxes
+/// contain their exact ones (see `node`), and the test only widens with the box, so through
+/// them the ray enters every box it would enter exactly, never later.
 #[inline(always)]
-pub(super) fn node_hits<I: Isa>(node: &BvhNode, ray: &SlabLanes<I>, t_limit: Real) -> (R8<I>, u32) {
+pub(super) fn node_hits<I: Isa>(boxes: &impl LaneBoxes, ray: &SlabLanes<I>, t_limit: Real) -> (R8<I>, u32) {
     let mut t_enter = R8::<I>::splat(0.0);
     let mut t_exit = R8::<I>::splat(t_limit * BOX_SLACK);
     for axis in 0..3 {
-        let negative = ray.negative[axis];
-        let (near, far) = (&node.bounds[negative as usize][axis], &node.bounds[!negative as usize][axis]);
-        let t_near = (R8::<I>::load(near) - ray.origin[axis]) * ray.inverse[axis];
-        let t_far = (R8::<I>::load(far) - ray.origin[axis]) * ray.far_inverse[axis];
+        let negative = ray.negative[axis] as usize;
+        let (near, far) = (boxes.planes::<I>(negative, axis), boxes.planes::<I>(1 - negative, axis));
+        let t_near = (near - ray.origin[axis]) * ray.inverse[axis];
+        let t_far = (far - ray.origin[axis]) * ray.far_inverse[axis];
         t_enter = t_near.max(t_enter);
         t_exit = t_far.min(t_exit);
     }
-    (t_enter, t_enter.le(t_exit).bits())
+    (t_enter, t_enter.le(t_exit).bits() & boxes.used())
 }
 
 /// A key that sorts children by the distance at which the ray enters them (non-negative and
@@ -75,28 +101,28 @@ pub(super) fn sort_key(t: Real, lane: usize) -> u64 {
 }
 
 /// The traversal stack: room for `STACK_SIZE` entries, the most any tree can need, and, unlike
-/// an array, not initialised (zeroing them for every ray would cost more than most rays push).
-/// A push never checks for room and a pop only for emptiness.
-struct Stack {
-    entries: [MaybeUninit<Pending>; STACK_SIZE],
+/// an array, not initialised (zeroing them for every ray would cost more than most rays push;
+/// a `Vec` would cost an allocation). A push never checks for room and a pop only for emptiness.
+pub(super) struct Stack<T> {
+    entries: [MaybeUninit<T>; STACK_SIZE],
     len: usize,
 }
 
-impl Stack {
+impl<T: Copy> Stack<T> {
     #[inline(always)]
-    fn new() -> Self {
+    pub(super) fn new() -> Self {
         Stack { entries: [const { MaybeUninit::uninit() }; STACK_SIZE], len: 0 }
     }
 
     #[inline(always)]
-    fn push(&mut self, entry: Pending) {
+    pub(super) fn push(&mut self, entry: T) {
         // In bounds: each node visited pushes at most `WIDTH - 1` entries (see `STACK_SIZE`).
         self.entries[self.len] = MaybeUninit::new(entry);
         self.len += 1;
     }
 
     #[inline(always)]
-    fn pop(&mut self) -> Option<Pending> {
+    pub(super) fn pop(&mut self) -> Option<T> {
         if self.len == 0 {
             return None;
         }
@@ -134,7 +160,7 @@ pub fn traverse<I: Isa>(nodes: &[BvhNode], ray: &Ray, t_max: Real, visitor: &mut
     }
     let slab = SlabLanes::<I>::new(ray);
     let mut t_limit = t_max;
-    let mut stack = Stack::new();
+    let mut stack = Stack::<Pending>::new();
     let mut current = Pending { t: 0.0, index: 0, count: 0 };
     loop {
         if current.count == 0 {
@@ -144,12 +170,12 @@ pub fn traverse<I: Isa>(nodes: &[BvhNode], ray: &Ray, t_max: Real, visitor: &mut
                 let first = hits.trailing_zeros() as usize;
                 let rest = hits & (hits - 1);
                 if rest == 0 {
-                    current = Pending { t: 0.0, index: node.child[first], count: node.count[first] };
+                    current = Pending { t: 0.0, index: node.child[first], count: node.count[first] as u32 };
                     continue;
                 }
                 let mut t = [0.0; WIDTH];
                 t_enter.store(&mut t);
-                let child = |lane: usize| Pending { t: t[lane], index: node.child[lane], count: node.count[lane] };
+                let child = |lane: usize| Pending { t: t[lane], index: node.child[lane], count: node.count[lane] as u32 };
                 if rest & (rest - 1) == 0 {
                     // Two children, the common case: the farther one waits.
                     let second = rest.trailing_zeros() as usize;

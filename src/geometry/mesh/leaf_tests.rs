@@ -61,7 +61,7 @@ fn nearest_in_packs<I: Isa>(
         while lanes != 0 {
             let lane = lanes.trailing_zeros() as usize;
             lanes &= lanes - 1;
-            let (t, triangle) = (values[0][lane], pack.ids()[lane]);
+            let (t, triangle) = (values[0][lane], pack.id(lane));
             let nearer = match closest {
                 Some(best) => t < best.t || (t == best.t && triangle < best.triangle),
                 None => true,
@@ -138,7 +138,7 @@ impl<I: Isa> PacketVisitor<I> for NearestTriangles<'_, I> {
                     continue;
                 }
                 let values = found.values::<8>();
-                let id = pack.ids()[triangle];
+                let id = pack.id(triangle);
                 while lanes != 0 {
                     let lane = lanes.trailing_zeros() as usize;
                     lanes &= lanes - 1;
