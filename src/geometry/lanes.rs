@@ -9,8 +9,9 @@
 
 use std::ops::{Add, Mul, Neg, Sub};
 
+use super::aabb::Aabb;
 use super::ray::{Ray, SurfaceHit};
-use super::real::{R8, Real, Vec3};
+use super::real::{R8, Real, Vec3, gamma};
 use crate::simd::{Isa, Lanes, MaskOps};
 
 /// Rays traced together.
@@ -273,5 +274,95 @@ impl<I: Isa> SurfaceLanes<I> {
         }
         let [point, point_error, geometric_normal, shading_normal] = vectors.map(|axes| V3::load(&axes));
         SurfaceLanes { t: R8::<I>::load(&t), point, point_error, geometric_normal, shading_normal }
+    }
+}
+
+/// Eight rays with their inverse directions, for [`RaySlabs::may_enter`].
+pub struct RaySlabs<I: Isa> {
+    origin: V3<I>,
+    inverse: V3<I>,
+}
+
+impl<I: Isa> RaySlabs<I> {
+    #[inline(always)]
+    pub fn new(rays: &RayLanes<I>) -> Self {
+        let one = R8::<I>::splat(1.0);
+        let d = rays.direction;
+        RaySlabs { origin: rays.origin, inverse: V3 { x: one / d.x, y: one / d.y, z: one / d.z } }
+    }
+
+    /// A bit per ray that may meet `bounds` at some `t ≥ 0`: a culling test, never a verdict. It
+    /// errs only towards "may", and more widely than the traversal's slab test (whose boxes the
+    /// single-ray queries must pass anyway): the far distance of each slab is widened by
+    /// `1 + 4·gamma(3)` where the traversal widens by `1 + 2·gamma(3)`, there is no `t_max`, and
+    /// a slab whose distances are undefined (a ray in the plane of a face, or anything not
+    /// finite) constrains nothing. So a ray the single-ray query would find inside the box is
+    /// never dropped.
+    #[inline(always)]
+    pub fn may_enter(&self, bounds: &Aabb) -> u32 {
+        let splat = R8::<I>::splat;
+        let widen = splat(1.0 + 4.0 * gamma(3));
+        let (mut near, mut far) = (splat(0.0), splat(Real::INFINITY));
+        for (o, inverse, min, max) in [
+            (self.origin.x, self.inverse.x, bounds.min.x, bounds.max.x),
+            (self.origin.y, self.inverse.y, bounds.min.y, bounds.max.y),
+            (self.origin.z, self.inverse.z, bounds.min.z, bounds.max.z),
+        ] {
+            let (t0, t1) = ((splat(min) - o) * inverse, (splat(max) - o) * inverse);
+            let undefined = t0.is_nan().or(t1.is_nan());
+            let slab_near = R8::<I>::select(undefined, splat(Real::NEG_INFINITY), t0.min(t1));
+            let slab_far = R8::<I>::select(undefined, splat(Real::INFINITY), t0.max(t1) * widen);
+            near = slab_near.max(near);
+            far = slab_far.min(far);
+        }
+        !near.gt(far).bits() & 0xff
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::simd::Portable;
+
+    fn may_enter(bounds: &Aabb, rays: &[Ray]) -> u32 {
+        let mut axes = [[[0.0; LANES]; 3]; 2];
+        for (lane, ray) in rays.iter().enumerate() {
+            for (axis, (o, d)) in [(ray.origin.x, ray.direction.x), (ray.origin.y, ray.direction.y), (ray.origin.z, ray.direction.z)]
+                .into_iter()
+                .enumerate()
+            {
+                (axes[0][axis][lane], axes[1][axis][lane]) = (o, d);
+            }
+        }
+        let lanes = RayLanes::<Portable> { origin: V3::load(&axes[0]), direction: V3::load(&axes[1]) };
+        RaySlabs::new(&lanes).may_enter(bounds) & ((1 << rays.len()) - 1)
+    }
+
+    /// Rays that touch the box, at its corners, along its edges and in the planes of its faces,
+    /// with zero direction components, are never culled; rays that pass it by or point away are.
+    #[test]
+    fn rays_that_touch_a_box_are_never_culled() {
+        for scale in [1.0e-3, 1.0, 7.0e4] {
+            let bounds = Aabb { min: Vec3::new(-1.0, 0.5, -3.0) * scale, max: Vec3::new(2.0, 1.5, -2.0) * scale };
+            let corner = bounds.max;
+            let touching = [
+                Ray::new(Vec3::ZERO, corner),
+                Ray::new(Vec3::new(corner.x, corner.y, 10.0 * scale), -Vec3::Z),
+                Ray::new(Vec3::new(bounds.min.x, 1.0 * scale, 10.0 * scale), -Vec3::Z),
+                Ray::new(Vec3::new(-5.0 * scale, bounds.max.y, bounds.min.z), Vec3::X),
+                Ray::new(bounds.min, Vec3::Y),
+                Ray::new((bounds.min + bounds.max) * 0.5, Vec3::new(0.3, -0.2, 0.9)),
+                Ray::new(Vec3::new(0.5, 1.0, 5.0) * scale, Vec3::new(0.0, 0.0, -1.0e-3)),
+                Ray::new(Vec3::new(-3.0, -4.0, 2.0) * scale, bounds.min - Vec3::new(-3.0, -4.0, 2.0) * scale),
+            ];
+            assert_eq!(may_enter(&bounds, &touching), 0xff, "scale {scale}");
+            let missing = [
+                Ray::new(Vec3::ZERO, -corner),
+                Ray::new(Vec3::new(corner.x * 1.01 + scale, corner.y, 10.0 * scale), -Vec3::Z),
+                Ray::new(Vec3::new(0.5, 1.0, 5.0) * scale, Vec3::Z),
+                Ray::new(Vec3::new(0.0, 10.0, 0.0) * scale, Vec3::new(1.0, 0.0, 0.0)),
+            ];
+            assert_eq!(may_enter(&bounds, &missing), 0, "scale {scale}");
+        }
     }
 }

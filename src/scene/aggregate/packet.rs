@@ -4,7 +4,7 @@
 //! alone: the same tests in the same arithmetic, and the same rule for ties (candidates are
 //! offered in the order of their ids, and a later one wins only when strictly nearer).
 
-use super::super::geometry::lanes::{LANES, RayLanes, SurfaceLanes, V3, lane, mask};
+use super::super::geometry::lanes::{LANES, RayLanes, RaySlabs, SurfaceLanes, V3, lane, mask};
 use super::super::real::{R8, Vec3};
 use super::*;
 use crate::simd::MaskOps;
@@ -97,10 +97,11 @@ impl Aggregate {
             ),
         };
         let mut hits = sphere_lanes | plane_lanes;
-        if !matches!(self.rest, Rest::Nothing) {
+        let candidates = self.rest_candidates::<I>(rays, active);
+        if candidates != 0 {
             let scalar_rays = rays.rays();
             let mut others = [None; LANES];
-            for k in set_lanes(active) {
+            for k in set_lanes(candidates) {
                 let mut closest = Closest { t: lane::<I>(nearest, k), id: ids[k], found: None };
                 self.closest_rest::<I>(&scalar_rays[k], &mut closest);
                 if let Some(found) = closest.found {
@@ -141,16 +142,39 @@ impl Aggregate {
             }
             blocked |= plane.intersect_rays::<I>(rays, t_max).0 & active;
         }
-        if !matches!(self.rest, Rest::Nothing) && blocked != active {
+        let candidates = if blocked == active { 0 } else { self.rest_candidates::<I>(rays, active & !blocked) };
+        if candidates != 0 {
             let scalar_rays = rays.rays();
             let mut limits = [0.0; LANES];
             t_max.store(&mut limits);
-            for k in set_lanes(active & !blocked) {
+            for k in set_lanes(candidates) {
                 if self.any_rest::<I>(&scalar_rays[k], limits[k]) {
                     blocked |= 1 << k;
                 }
             }
         }
         blocked
+    }
+
+    /// The rays of `active` that may meet one of the objects that are neither packed spheres nor
+    /// planes: those whose bounds they may enter, when the objects have bounds to cull with.
+    #[inline(always)]
+    fn rest_candidates<I: Isa>(&self, rays: &RayLanes<I>, active: u32) -> u32 {
+        match &self.rest {
+            Rest::Nothing => 0,
+            Rest::One { bounds: Some(bounds), .. } => active & RaySlabs::new(rays).may_enter(bounds),
+            Rest::Few { bounds, .. } => {
+                let slabs = RaySlabs::new(rays);
+                let mut candidates = 0;
+                for bounds in bounds {
+                    candidates |= slabs.may_enter(bounds);
+                    if candidates & active == active {
+                        break;
+                    }
+                }
+                active & candidates
+            }
+            Rest::One { bounds: None, .. } | Rest::Tree { .. } => active,
+        }
     }
 }
