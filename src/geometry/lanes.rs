@@ -21,20 +21,12 @@ pub const LANES: usize = 8;
 pub type Mask<I> = <R8<I> as Lanes>::Mask;
 
 /// Eight vectors, one per lane.
+#[derive(Clone, Copy)]
 pub struct V3<I: Isa> {
     pub x: R8<I>,
     pub y: R8<I>,
     pub z: R8<I>,
 }
-
-impl<I: Isa> Clone for V3<I> {
-    #[inline(always)]
-    fn clone(&self) -> Self {
-        *self
-    }
-}
-
-impl<I: Isa> Copy for V3<I> {}
 
 /// For each 8-bit set of lanes, 1 in the lanes of the set and 0 elsewhere.
 const FLAGS: [[Real; LANES]; 1 << LANES] = {
@@ -197,19 +189,11 @@ impl<I: Isa> Neg for V3<I> {
 }
 
 /// Eight rays `origin + t·direction`.
+#[derive(Clone, Copy)]
 pub struct RayLanes<I: Isa> {
     pub origin: V3<I>,
     pub direction: V3<I>,
 }
-
-impl<I: Isa> Clone for RayLanes<I> {
-    #[inline(always)]
-    fn clone(&self) -> Self {
-        *self
-    }
-}
-
-impl<I: Isa> Copy for RayLanes<I> {}
 
 impl<I: Isa> RayLanes<I> {
     #[inline(always)]
@@ -226,6 +210,7 @@ impl<I: Isa> RayLanes<I> {
 }
 
 /// Eight [`SurfaceHit`]s, one per lane.
+#[derive(Clone, Copy)]
 pub struct SurfaceLanes<I: Isa> {
     pub t: R8<I>,
     pub point: V3<I>,
@@ -233,15 +218,6 @@ pub struct SurfaceLanes<I: Isa> {
     pub geometric_normal: V3<I>,
     pub shading_normal: V3<I>,
 }
-
-impl<I: Isa> Clone for SurfaceLanes<I> {
-    #[inline(always)]
-    fn clone(&self) -> Self {
-        *self
-    }
-}
-
-impl<I: Isa> Copy for SurfaceLanes<I> {}
 
 impl<I: Isa> SurfaceLanes<I> {
     /// `mask ? if_true : if_false` per lane, field by field.
