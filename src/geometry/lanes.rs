@@ -51,12 +51,18 @@ pub fn mask<I: Isa>(bits: u32) -> Mask<I> {
     R8::<I>::load(&FLAGS[(bits & 0xff) as usize]).gt(R8::<I>::splat(0.0))
 }
 
-/// Lane `lane` of `value`.
-#[inline(always)]
-pub fn lane<I: Isa>(value: R8<I>, lane: usize) -> Real {
-    let mut lanes = [0.0; LANES];
-    value.store(&mut lanes);
-    lanes[lane]
+/// The index of every set bit of `bits`, lowest first: the lanes of a set. Kernels loop over
+/// these rather than call a closure per lane: a closure is compiled as a function of its own,
+/// without the instructions of the kernel that calls it, and the SIMD code inside it would then
+/// call each intrinsic as a function.
+pub fn set_lanes(mut bits: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (bits != 0).then(|| {
+            let lane = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            lane
+        })
+    })
 }
 
 impl<I: Isa> V3<I> {

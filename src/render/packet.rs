@@ -9,7 +9,7 @@
 //! that needs them. So the picture is bit-identical whichever integrator draws it, and the
 //! renderer uses this one for every render without the catalogue's integrator faults.
 
-use super::geometry::lanes::{LANES, Mask, RayLanes, V3, lane, mask};
+use super::geometry::lanes::{LANES, Mask, RayLanes, V3, mask, set_lanes};
 use super::geometry::spawn::{spawn_lanes, spawn_to_lanes};
 use super::real::{Color, R8, Real, Vec2, Vec3};
 use super::scene::light::Light;
@@ -100,9 +100,10 @@ impl<'a> WhittedLanes<'a> {
             }
             active &= hit.hits;
             if depth == 0 && first_hits {
-                let (normals, surface) = (hit.surface.shading_normal.vectors(), &hit.surface);
-                for (k, first) in first.iter_mut().enumerate().filter(|(k, _)| active & (1 << k) != 0) {
-                    *first = Some((lane::<I>(surface.t, k), normals[k]));
+                let (normals, mut t) = (hit.surface.shading_normal.vectors(), [0.0; LANES]);
+                hit.surface.t.store(&mut t);
+                for k in set_lanes(active) {
+                    first[k] = Some((t[k], normals[k]));
                 }
             }
             if active == 0 {
@@ -129,7 +130,8 @@ impl<'a> WhittedLanes<'a> {
     fn materials<I: Isa>(&self, hit: &HitLanes<I>, active: u32) -> MaterialLanes<I> {
         let (mut diffuse, mut specular) = ([Vec3::ZERO; LANES], [Vec3::ZERO; LANES]);
         let (mut shininess, mut matte, mut mirror) = ([0.0; LANES], 0, 0);
-        for (k, &index) in hit.material.iter().enumerate().filter(|(k, _)| active & (1 << k) != 0) {
+        for k in set_lanes(active) {
+            let index = hit.material[k];
             let material = &self.scene.materials[index as usize];
             (diffuse[k], specular[k], shininess[k]) = (material.diffuse, material.specular, material.shininess);
             matte |= u32::from(!material.reflects()) << k;
@@ -227,10 +229,10 @@ fn shade<I: Isa>(
     }
     let mut highlight = [0.0; LANES];
     cos_view.store(&mut highlight);
-    for (k, h) in highlight.iter_mut().enumerate().filter(|(k, _)| highlighted & (1 << k) != 0) {
+    for k in set_lanes(highlighted) {
         let shininess = materials.shininess[k];
         if shininess != 1.0 {
-            *h = h.powf(shininess);
+            highlight[k] = highlight[k].powf(shininess);
         }
     }
     let with_highlight = (diffuse + materials.specular.scale(R8::<I>::load(&highlight))) * intensity;

@@ -29,12 +29,6 @@ impl Sampler {
         self.strata * self.strata
     }
 
-    /// Position of sample `index` inside pixel `(x, y)`, in `[0, 1)²`: a uniformly jittered point
-    /// in stratum `(index mod n, index div n)`.
-    pub fn offset(&self, x: u32, y: u32, index: u32) -> Vec2 {
-        self.pixel(x, y).offset(index)
-    }
-
     /// The samples of pixel `(x, y)`: the part of the hash that depends on the pixel alone is
     /// mixed once, not once per sample.
     #[inline(always)]
@@ -58,7 +52,8 @@ pub struct PixelSamples {
 }
 
 impl PixelSamples {
-    /// [`Sampler::offset`] of sample `index`. Always inlined: called once per sample, it costs
+    /// Position of sample `index` inside the pixel, in `[0, 1)²`: a uniformly jittered point in
+    /// stratum `(index mod n, index div n)`. Always inlined: called once per sample, it costs
     /// a sampled render 19% when the compiler leaves it out of line (README, "Sampled cases").
     #[inline(always)]
     pub fn offset(&self, index: u32) -> Vec2 {
@@ -107,14 +102,14 @@ mod tests {
     #[test]
     fn one_sample_is_the_centre() {
         let s = Sampler::new(1, 7);
-        assert_eq!(s.offset(3, 4, 0), Vec2::splat(0.5));
+        assert_eq!(s.pixel(3, 4).offset(0), Vec2::splat(0.5));
     }
 
     #[test]
     fn each_sample_stays_in_its_stratum() {
         let s = Sampler::new(16, 42);
         for index in 0..16 {
-            let p = s.offset(10, 20, index);
+            let p = s.pixel(10, 20).offset(index);
             let (sx, sy) = ((index % 4) as Real, (index / 4) as Real);
             assert!(p.x >= sx / 4.0 && p.x < (sx + 1.0) / 4.0);
             assert!(p.y >= sy / 4.0 && p.y < (sy + 1.0) / 4.0);
@@ -124,15 +119,15 @@ mod tests {
     #[test]
     fn samples_depend_on_seed_pixel_and_index_only() {
         let a = Sampler::new(4, 1);
-        assert_eq!(a.offset(5, 6, 2), Sampler::new(4, 1).offset(5, 6, 2));
-        assert_ne!(a.offset(5, 6, 2), Sampler::new(4, 2).offset(5, 6, 2));
-        assert_ne!(a.offset(5, 6, 2), a.offset(6, 5, 2));
+        assert_eq!(a.pixel(5, 6).offset(2), Sampler::new(4, 1).pixel(5, 6).offset(2));
+        assert_ne!(a.pixel(5, 6).offset(2), Sampler::new(4, 2).pixel(5, 6).offset(2));
+        assert_ne!(a.pixel(5, 6).offset(2), a.pixel(6, 5).offset(2));
     }
 
     #[test]
     fn jitter_is_roughly_uniform() {
         let s = Sampler::new(4, 3);
-        let mean: Real = (0..10_000u32).map(|i| s.offset(i, i / 7, 0).x * 2.0).sum::<Real>() / 10_000.0;
+        let mean: Real = (0..10_000u32).map(|i| s.pixel(i, i / 7).offset(0).x * 2.0).sum::<Real>() / 10_000.0;
         assert!((mean - 0.5).abs() < 0.02, "{mean}");
     }
 }

@@ -42,7 +42,7 @@ enum Rest {
     One { object: u32, bounds: Option<Aabb> },
     /// A handful of objects behind their boxes, tested by one slab test: `objects[lane]` is the
     /// object of box `lane`.
-    Few { boxes: Box<BoxSet>, objects: Vec<u32>, bounds: Vec<Aabb> },
+    Few { boxes: Box<BoxSet>, objects: Vec<u32> },
     /// A tree whose leaves hold positions in `objects`: object indices in the tree's leaf order.
     Tree { bvh: Bvh, objects: Vec<u32> },
 }
@@ -106,7 +106,7 @@ impl Aggregate {
             }
             few if few.len() <= WIDTH => {
                 let bounds: Vec<Aabb> = few.iter().map(|&index| traced[index as usize].bounds()).collect();
-                Rest::Few { boxes: Box::new(BoxSet::new(&bounds)), objects: others, bounds }
+                Rest::Few { boxes: Box::new(BoxSet::new(&bounds)), objects: others }
             }
             _ => {
                 let bounds: Vec<Aabb> = others.iter().map(|&index| traced[index as usize].bounds()).collect();
@@ -216,7 +216,7 @@ impl Aggregate {
                     closest.offer(hit.t(), *object, Found::Object(*object, hit));
                 }
             }
-            Rest::Few { boxes, objects, .. } => {
+            Rest::Few { boxes, objects } => {
                 let (hits, t) = boxes.entered::<I>(ray, closest.t);
                 if hits != 0 {
                     let (keys, count) = BoxSet::nearest_first(hits, &t);
@@ -282,7 +282,7 @@ impl Aggregate {
                 bounds.is_none_or(|bounds| bounds.hit_by(&SlabRay::new(ray), t_max))
                     && self.traced[*object as usize].occluded_lanes::<I>(ray, t_max)
             }
-            Rest::Few { boxes, objects, .. } => {
+            Rest::Few { boxes, objects } => {
                 let (mut hits, _) = boxes.entered::<I>(ray, t_max);
                 while hits != 0 {
                     let lane = hits.trailing_zeros() as usize;

@@ -2,7 +2,7 @@
 
 use super::super::Ray;
 use super::super::aabb::Aabb;
-use super::super::real::Real;
+use super::super::real::{Real, Vec3};
 use crate::simd::{Isa, Lanes};
 use super::*;
 use super::super::real::R8;
@@ -46,6 +46,14 @@ impl BoxSet {
             }
         }
         set
+    }
+
+    /// The boxes, in the order they were given.
+    pub fn boxes(&self) -> impl Iterator<Item = Aabb> + '_ {
+        (0..self.len).map(|lane| {
+            let corner = |side: usize| Vec3::new(self.bounds[side][0][lane], self.bounds[side][1][lane], self.bounds[side][2][lane]);
+            Aabb { min: corner(0), max: corner(1) }
+        })
     }
 
     pub fn len(&self) -> usize {

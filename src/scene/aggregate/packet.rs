@@ -4,7 +4,7 @@
 //! alone: the same tests in the same arithmetic, and the same rule for ties (candidates are
 //! offered in the order of their ids, and a later one wins only when strictly nearer).
 
-use super::super::geometry::lanes::{LANES, RayLanes, RaySlabs, SurfaceLanes, V3, lane, mask};
+use super::super::geometry::lanes::{LANES, RayLanes, RaySlabs, SurfaceLanes, V3, mask, set_lanes};
 use super::super::real::{R8, Vec3};
 use super::*;
 use crate::simd::MaskOps;
@@ -16,19 +16,6 @@ pub struct HitLanes<I: Isa> {
     pub surface: SurfaceLanes<I>,
     /// Each lane's material.
     pub material: [u32; LANES],
-}
-
-/// The index of every set bit of `bits`, lowest first. A loop over these, not a closure per lane:
-/// a closure is compiled as a function of its own, without the instructions of the kernel that
-/// calls it, and the SIMD code inside it would then call each intrinsic as a function.
-fn set_lanes(mut bits: u32) -> impl Iterator<Item = usize> {
-    std::iter::from_fn(move || {
-        (bits != 0).then(|| {
-            let lane = bits.trailing_zeros() as usize;
-            bits &= bits - 1;
-            lane
-        })
-    })
 }
 
 impl Aggregate {
@@ -46,10 +33,7 @@ impl Aggregate {
         if !self.spheres.is_empty() {
             let sphere_rays = SphereRay::<I>::lanes(rays);
             for pack in &self.spheres {
-                let mut live = pack.live();
-                while live != 0 {
-                    let k = live.trailing_zeros() as usize;
-                    live &= live - 1;
+                for k in set_lanes(pack.live()) {
                     let sphere = pack.sphere(k);
                     let (hits, t) = sphere.intersect_rays::<I>(&sphere_rays, infinity);
                     let nearer = hits & active & t.lt(nearest).bits();
@@ -88,9 +72,9 @@ impl Aggregate {
             }
         }
         let mut surface = match (sphere_lanes != 0, plane_lanes != 0) {
-            (true, false) => Sphere::surface_lanes(center, radius, rays, nearest),
+            (_, false) => Sphere::surface_lanes(center, radius, rays, nearest),
             (false, true) => Plane::surface_lanes(normal, offset, shading_normal, rays, nearest),
-            _ => SurfaceLanes::select(
+            (true, true) => SurfaceLanes::select(
                 mask::<I>(plane_lanes),
                 &Plane::surface_lanes(normal, offset, shading_normal, rays, nearest),
                 &Sphere::surface_lanes(center, radius, rays, nearest),
@@ -101,8 +85,10 @@ impl Aggregate {
         if candidates != 0 {
             let scalar_rays = rays.rays();
             let mut others = [None; LANES];
+            let mut t = [0.0; LANES];
+            nearest.store(&mut t);
             for k in set_lanes(candidates) {
-                let mut closest = Closest { t: lane::<I>(nearest, k), id: ids[k], found: None };
+                let mut closest = Closest { t: t[k], id: ids[k], found: None };
                 self.closest_rest::<I>(&scalar_rays[k], &mut closest);
                 if let Some(found) = closest.found {
                     let intersection = self.intersection(&scalar_rays[k], found);
@@ -128,10 +114,10 @@ impl Aggregate {
         if !self.spheres.is_empty() {
             let sphere_rays = SphereRay::<I>::lanes(rays);
             for pack in &self.spheres {
-                let mut live = pack.live();
-                while live != 0 && blocked != active {
-                    let k = live.trailing_zeros() as usize;
-                    live &= live - 1;
+                for k in set_lanes(pack.live()) {
+                    if blocked == active {
+                        break;
+                    }
                     blocked |= pack.sphere(k).intersect_rays::<I>(&sphere_rays, t_max).0 & active;
                 }
             }
@@ -163,11 +149,11 @@ impl Aggregate {
         match &self.rest {
             Rest::Nothing => 0,
             Rest::One { bounds: Some(bounds), .. } => active & RaySlabs::new(rays).may_enter(bounds),
-            Rest::Few { bounds, .. } => {
+            Rest::Few { boxes, .. } => {
                 let slabs = RaySlabs::new(rays);
                 let mut candidates = 0;
-                for bounds in bounds {
-                    candidates |= slabs.may_enter(bounds);
+                for bounds in boxes.boxes() {
+                    candidates |= slabs.may_enter(&bounds);
                     if candidates & active == active {
                         break;
                     }
