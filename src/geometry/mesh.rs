@@ -166,23 +166,28 @@ impl Mesh {
             type Output = [Option<MeshHit>; PACKET];
             #[inline(always)]
             fn run<I: Isa>(self) -> [Option<MeshHit>; PACKET] {
-                self.0.closest_packet::<I>(self.1, self.2)
+                self.0.closest_packet::<I>(self.1, &[self.2; PACKET])
             }
         }
         dispatch(Closest(self, rays, t_max))
     }
 
+    /// [`Mesh::intersect_packet`] inside a caller's kernel (see `crate::simd`), ray `k` with its
+    /// own `t_max[k]`: each result exactly what [`Mesh::closest_lanes`] returns for that ray.
+    ///
+    /// # Panics
+    /// If there are more than [`PACKET`] rays.
     #[inline(always)]
-    fn closest_packet<I: Isa>(&self, rays: &[Ray], t_max: Real) -> [Option<MeshHit>; PACKET] {
+    pub fn closest_packet<I: Isa>(&self, rays: &[Ray], t_max: &[Real; PACKET]) -> [Option<MeshHit>; PACKET] {
         let (Some(slab), Some(triangle_rays)) = (PacketLanes::<I>::new(rays), RayLanes::<I>::new(rays)) else {
             let mut closest = [None; PACKET];
-            for (hit, ray) in closest.iter_mut().zip(rays) {
+            for ((hit, ray), &t_max) in closest.iter_mut().zip(rays).zip(t_max) {
                 *hit = self.closest_lanes::<I>(ray, t_max);
             }
             return closest;
         };
         let mut nearest = NearestTriangles { mesh: self, rays: triangle_rays, closest: [None; PACKET] };
-        let mut t_limit = [t_max; PACKET];
+        let mut t_limit = *t_max;
         traverse_packet::<I>(self.bvh.nodes(), &slab, (1u32 << rays.len()) - 1, &mut t_limit, &mut nearest);
         nearest.closest
     }

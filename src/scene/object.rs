@@ -3,6 +3,7 @@
 use std::sync::Arc;
 
 use super::geometry::aabb::Aabb;
+use super::geometry::bvh::PACKET;
 use super::geometry::mesh::{Mesh, MeshHit};
 use super::geometry::sphere::Sphere;
 use super::geometry::transform::Transform;
@@ -159,6 +160,35 @@ impl Object {
         Some(hit.shifted(shift))
     }
 
+    /// [`Object::intersect_lanes`] for up to [`PACKET`] rays, ray `k` with its own `t_max[k]`;
+    /// each result exactly what [`Object::intersect_lanes`] returns for that ray alone. A mesh
+    /// traces the rays as one packet when they are coherent enough (see
+    /// [`Mesh::closest_packet`]); other shapes take them one by one.
+    ///
+    /// # Panics
+    /// If there are more than [`PACKET`] rays.
+    #[inline(always)]
+    pub fn intersect_packet<I: Isa>(&self, world_rays: &[Ray], t_max: &[Real; PACKET]) -> [Option<ShapeHit>; PACKET] {
+        let mut found = [None; PACKET];
+        let Shape::Mesh(mesh) = &self.shape else {
+            for ((found, ray), &t_max) in found.iter_mut().zip(world_rays).zip(t_max) {
+                *found = self.intersect_lanes::<I>(ray, t_max);
+            }
+            return found;
+        };
+        let mut rays = [Ray::new(Vec3::ZERO, Vec3::Z); PACKET];
+        let (mut shifts, mut limits) = ([0.0; PACKET], [0.0; PACKET]);
+        for (k, world_ray) in world_rays.iter().enumerate() {
+            (rays[k], shifts[k]) = self.local_ray(world_ray);
+            limits[k] = t_max[k] - shifts[k];
+        }
+        let hits = mesh.closest_packet::<I>(&rays[..world_rays.len()], &limits);
+        for ((found, hit), shift) in found.iter_mut().zip(hits).zip(shifts) {
+            *found = hit.map(|hit| ShapeHit::Mesh(hit).shifted(shift));
+        }
+        found
+    }
+
     pub fn occluded(&self, world_ray: &Ray, t_max: Real) -> bool {
         struct Any<'a>(&'a Object, &'a Ray, Real);
         impl Kernel for Any<'_> {
@@ -239,6 +269,51 @@ mod tests {
                 assert!(placed.occluded(&ray, expected.t() * 1.01));
             }
         }
+    }
+
+    /// Rays offered as a packet, each with its own limit, find what each finds alone: through a
+    /// transform, coherent (one packet) or not (ray by ray), limits cutting some hits off.
+    #[test]
+    fn a_packet_of_rays_finds_what_each_ray_finds_alone() {
+        use crate::simd::{Isa, Kernel, dispatch};
+        struct Packet<'a>(&'a Object, &'a [Ray], [Real; PACKET]);
+        impl Kernel for Packet<'_> {
+            type Output = [Option<ShapeHit>; PACKET];
+            fn run<I: Isa>(self) -> Self::Output {
+                self.0.intersect_packet::<I>(self.1, &self.2)
+            }
+        }
+        let (positions, triangles) = blob(3, 2);
+        let mesh = Arc::new(Mesh::new(&positions, &triangles, VertexNormals::Averaged).unwrap());
+        let matrix = Mat4::from_translation(Vec3::new(0.5, -2.0, 1.0)) * Mat4::from_scale(Vec3::new(3.0, 2.0, 2.5));
+        let transform = Some(Arc::new(Transform::new(matrix).unwrap()));
+        let origin = Vec3::new(0.3, -1.5, 9.0);
+        let mut hits = 0;
+        for (k, spread) in [0.05, 0.4, 3.0].into_iter().enumerate() {
+            for object in [
+                Object { shape: Shape::Mesh(mesh.clone()), transform: transform.clone(), material: 0 },
+                Object { shape: Shape::Mesh(mesh.clone()), transform: None, material: 0 },
+            ] {
+                for count in [1, 5, PACKET] {
+                    let rays: Vec<Ray> = (0..count)
+                        .map(|i| {
+                            let angle = (i + 3 * k) as Real;
+                            let aim = Vec3::new(spread * angle.cos(), -2.0 + spread * angle.sin(), 0.0);
+                            Ray::new(origin, aim - origin)
+                        })
+                        .collect();
+                    let limits: [Real; PACKET] = std::array::from_fn(|i| if i % 3 == 1 { 8.0 } else { Real::INFINITY });
+                    let packet = dispatch(Packet(&object, &rays, limits));
+                    for (i, ray) in rays.iter().enumerate() {
+                        let alone = object.intersect(ray, limits[i]);
+                        assert_eq!(format!("{:?}", packet[i]), format!("{alone:?}"), "ray {i} of {count}, spread {spread}");
+                        hits += alone.is_some() as usize;
+                    }
+                    assert!(packet[count..].iter().all(Option::is_none));
+                }
+            }
+        }
+        assert!(hits > 30, "the rays hit the mesh: {hits}");
     }
 
     #[test]

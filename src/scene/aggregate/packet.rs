@@ -4,6 +4,7 @@
 //! alone: the same tests in the same arithmetic, and the same rule for ties (candidates are
 //! offered in the order of their ids, and a later one wins only when strictly nearer).
 
+use super::super::geometry::bvh::PACKET;
 use super::super::geometry::lanes::{LANES, RayLanes, RaySlabs, SurfaceLanes, V3, mask, set_lanes};
 use super::super::real::{R8, Vec3};
 use super::*;
@@ -87,10 +88,9 @@ impl Aggregate {
             let mut others = [None; LANES];
             let mut t = [0.0; LANES];
             nearest.store(&mut t);
+            let found = self.closest_rest_packet::<I>(&scalar_rays, candidates, &t, &ids);
             for k in set_lanes(candidates) {
-                let mut closest = Closest { t: t[k], id: ids[k], found: None };
-                self.closest_rest::<I>(&scalar_rays[k], &mut closest);
-                if let Some(found) = closest.found {
+                if let Some(found) = found[k] {
                     let intersection = self.intersection(&scalar_rays[k], found);
                     others[k] = Some(intersection.surface);
                     material[k] = intersection.material;
@@ -140,6 +140,49 @@ impl Aggregate {
             }
         }
         blocked
+    }
+
+    /// For each ray of `candidates`, what [`Aggregate::closest_rest`] finds beyond the nearest
+    /// sphere or plane hit so far (at `t[k]`, of object `ids[k]`). A lone object is offered the
+    /// candidates as a packet ([`Object::intersect_packet`]); otherwise ray by ray.
+    #[inline(always)]
+    fn closest_rest_packet<I: Isa>(
+        &self,
+        rays: &[Ray; LANES],
+        candidates: u32,
+        t: &[Real; LANES],
+        ids: &[u32; LANES],
+    ) -> [Option<Found>; LANES] {
+        let mut found = [None; LANES];
+        let Rest::One { object, bounds } = &self.rest else {
+            for k in set_lanes(candidates) {
+                let mut closest = Closest { t: t[k], id: ids[k], found: None };
+                self.closest_rest::<I>(&rays[k], &mut closest);
+                found[k] = closest.found;
+            }
+            return found;
+        };
+        // The candidates that enter the object's box, as `closest_rest` tests it, packed first.
+        let (mut packed, mut lanes, mut limits) = ([rays[0]; PACKET], [0; PACKET], [0.0; PACKET]);
+        let mut count = 0;
+        for k in set_lanes(candidates) {
+            if bounds.is_none_or(|bounds| bounds.hit_by(&SlabRay::new(&rays[k]), t[k])) {
+                (packed[count], lanes[count], limits[count]) = (rays[k], k, t[k]);
+                count += 1;
+            }
+        }
+        if count == 0 {
+            return found;
+        }
+        let hits = self.traced[*object as usize].intersect_packet::<I>(&packed[..count], &limits);
+        for (hit, &k) in hits.into_iter().zip(&lanes[..count]) {
+            if let Some(hit) = hit {
+                let mut closest = Closest { t: t[k], id: ids[k], found: None };
+                closest.offer(hit.t(), *object, Found::Object(*object, hit));
+                found[k] = closest.found;
+            }
+        }
+        found
     }
 
     /// The rays of `active` that may meet one of the objects that are neither packed spheres nor
