@@ -116,7 +116,14 @@ impl Bvh {
     /// [`Bvh::build`] for leaves whose primitives are tested as `cost` says (a mesh tests up to
     /// four triangles at once, so a leaf of four costs what a leaf of one does).
     pub fn build_for(bounds: &[Aabb], cost: LeafCost) -> Bvh {
-        let (binary, prim_indices) = build::build(bounds, cost);
+        Bvh::build_from(bounds.len(), |index| bounds[index], cost)
+    }
+
+    /// [`Bvh::build_for`] of the `count` boxes `bounds_of(0..count)`, computed as the build
+    /// needs them (in parallel), for a caller that would otherwise make a list of them only
+    /// to hand it over.
+    pub fn build_from(count: usize, bounds_of: impl Fn(usize) -> Aabb + Sync, cost: LeafCost) -> Bvh {
+        let (binary, prim_indices) = build::build(count, bounds_of, cost);
         Bvh {
             bounds: binary.first().map_or(Aabb::EMPTY, |root| root.bounds),
             nodes: collapse::collapse(&binary),

@@ -101,12 +101,12 @@ impl Mesh {
         };
         let corners_of = |[a, b, c]: [u32; 3]| [positions[a as usize], positions[b as usize], positions[c as usize]];
         let build_start = Instant::now();
-        let bounds: Vec<Aabb> = triangles.par_iter().map(|&t| Aabb::from_points(corners_of(t))).collect();
-        let (mut bvh, order) = Bvh::build_for(&bounds, LeafCost::PerPackOfFour).into_leaf_order();
-        drop(bounds);
+        let bounds_of = |index: usize| Aabb::from_points(corners_of(triangles[index]));
+        let (mut bvh, order) = Bvh::build_from(triangles.len(), bounds_of, LeafCost::PerPackOfFour).into_leaf_order();
         let corners: Vec<[Vec3; 3]> = order.par_iter().map(|&i| corners_of(triangles[i as usize])).collect();
-        let flat = FlatLeaves::new(&bvh.leaves(), &corners);
-        let packs = pack_leaves(&mut bvh, &corners);
+        let leaves = bvh.leaves();
+        let flat = FlatLeaves::new(&leaves, &corners);
+        let packs = pack_leaves(&mut bvh, &leaves, &corners);
         let bvh_build_time = build_start.elapsed();
         Ok(Mesh {
             corners,
@@ -270,25 +270,18 @@ impl Mesh {
 
 /// Packs each leaf's triangles (`corners` is in leaf order) four at a time, in leaf order, and
 /// points the leaf at its packs.
-fn pack_leaves(bvh: &mut Bvh, corners: &[[Vec3; 3]]) -> Vec<TrianglePack> {
-    let leaves = bvh.leaves();
-    // Where each leaf's packs start, by the leaf's first triangle.
+fn pack_leaves(bvh: &mut Bvh, leaves: &[(u32, u32)], corners: &[[Vec3; 3]]) -> Vec<TrianglePack> {
+    // Each pack's run of triangles, and where each leaf's packs start (by its first triangle).
+    let mut runs = Vec::with_capacity(corners.len().div_ceil(4) + leaves.len());
     let mut first_pack = vec![0u32; corners.len()];
-    let mut packed = 0;
-    for &(first, count) in &leaves {
-        first_pack[first as usize] = packed;
-        packed += count.div_ceil(4);
+    for &(first, count) in leaves {
+        first_pack[first as usize] = runs.len() as u32;
+        runs.extend((first..first + count).step_by(4).map(|start| (start, (start + 4).min(first + count))));
     }
-    let mut packs = huge_page_vec(packed as usize);
-    let all = leaves
-        .par_iter()
-        .flat_map_iter(|&(first, count)| {
-            (first..first + count).step_by(4).map(move |start| {
-                let end = (start + 4).min(first + count);
-                TrianglePack::new(start, &corners[start as usize..end as usize])
-            })
-        });
-    packs.par_extend(all);
+    // An indexed parallel iterator writes each pack in its place, where `flat_map` would
+    // gather them in pieces and copy them again.
+    let mut packs = huge_page_vec(runs.len());
+    packs.par_extend(runs.par_iter().map(|&(start, end)| TrianglePack::new(start, &corners[start as usize..end as usize])));
     bvh.remap_leaves(|first, count| (first_pack[first as usize], count.div_ceil(4)));
     packs
 }

@@ -28,6 +28,9 @@ const PARALLEL_THRESHOLD: usize = 4096;
 /// From this many primitives a node's binning pass is itself split among threads (the first
 /// levels of the tree, before there are subtrees enough to keep every thread busy).
 const PARALLEL_BINNING: usize = 1 << 17;
+/// From this many primitives a node is binned into two interleaved sets of bins (see
+/// [`Bins::fill`]); below, the second set would cost more to clear and merge than it saves.
+const INTERLEAVED_BINNING: usize = 64;
 /// Depth after which only median splits are made. SAH splits may peel off one primitive at a
 /// time on adversarial input; median splits guarantee the remaining depth is logarithmic.
 pub(super) const SAH_DEPTH_LIMIT: usize = 32;
@@ -89,20 +92,15 @@ impl BinaryNode {
     }
 }
 
-/// Returns the nodes in depth-first order and the primitive indices in leaf order.
-pub(super) fn build(bounds: &[Aabb], cost: LeafCost) -> (Vec<BinaryNode>, Vec<u32>) {
-    assert!(
-        u32::try_from(bounds.len()).is_ok(),
-        "a BVH holds at most u32::MAX primitives"
-    );
-    if bounds.is_empty() {
+/// Returns the nodes in depth-first order and the primitive indices in leaf order, for the
+/// `count` primitives whose boxes are `bounds_of(0..count)`.
+pub(super) fn build(count: usize, bounds_of: impl Fn(usize) -> Aabb + Sync, cost: LeafCost) -> (Vec<BinaryNode>, Vec<u32>) {
+    assert!(u32::try_from(count).is_ok(), "a BVH holds at most u32::MAX primitives");
+    if count == 0 {
         return (Vec::new(), Vec::new());
     }
-    let mut prims: Vec<Prim> = bounds
-        .par_iter()
-        .enumerate()
-        .map(|(index, bounds)| Prim::new(bounds, index))
-        .collect();
+    let mut prims: Vec<Prim> = Vec::with_capacity(count);
+    prims.par_extend((0..count).into_par_iter().map(|index| Prim::new(&bounds_of(index), index)));
     let root = Extent::of_parallel(&prims);
     let subtree = build_parallel(Node { prims: &mut prims, extent: root, first: 0, depth: 0 }, cost);
     let mut nodes = Vec::new();
@@ -348,7 +346,7 @@ fn plan(prims: &mut [Prim], extent: Extent, depth: usize, cost: LeafCost) -> Pla
     if count <= cost.max_leaf() && TRAVERSAL_COST * area + split_cost >= leaf_cost {
         return Plan::Leaf;
     }
-    let (mid, below_centroids, above_centroids) = partition(prims, |prim| bins.bin(prim) <= split_bin);
+    let (mid, below_centroids, above_centroids) = partition(prims, |prim| bins.at_or_below(prim, split_bin));
     let side = |range: std::ops::Range<usize>| binned.boxes[range].iter().fold(Bounds::EMPTY, |b, bin| b.union(bin));
     Plan::Split {
         mid,
@@ -366,21 +364,50 @@ struct Bins {
 }
 
 impl Bins {
+    /// Where `prim`'s centroid falls in units of bins from `low`: its bin is this, truncated
+    /// and clamped to the bins.
     #[inline(always)]
-    fn bin(&self, prim: &Prim) -> usize {
-        // The float-to-int cast saturates (NaN becomes 0), so every value lands in a bin, even
-        // when a tiny spread makes `per_unit` infinite.
-        (((prim.centroid(self.axis) - self.low) * self.per_unit) as i32).clamp(0, BIN_COUNT as i32 - 1) as usize
+    fn position(&self, prim: &Prim) -> Real {
+        (prim.centroid(self.axis) - self.low) * self.per_unit
     }
 
+    #[inline(always)]
+    fn bin(&self, prim: &Prim) -> usize {
+        // `max` turns NaN into 0, so every value lands in a bin, even when a tiny spread makes
+        // `per_unit` infinite; the truncation then needs no saturation.
+        self.position(prim).max(0.0).min((BIN_COUNT - 1) as Real) as i32 as usize
+    }
+
+    /// Whether `prim` falls in bin `split` or below: `bin(prim) <= split` as one comparison
+    /// (the bins are monotonic in `position`, and NaN falls in bin 0).
+    #[inline(always)]
+    fn at_or_below(&self, prim: &Prim, split: usize) -> bool {
+        let position = self.position(prim);
+        position < (split + 1) as Real || position.is_nan()
+    }
+
+    /// Large nodes are binned into two interleaved sets of bins, merged at the end: consecutive
+    /// primitives often fall in the same bin (a node's primitives lie in the order the
+    /// partitions above left them), and one set would make each box's growth wait for the
+    /// previous one's.
     fn fill(&self, prims: &[Prim]) -> Binned {
-        let mut binned = Binned::empty();
-        for prim in prims {
-            let bin = self.bin(prim);
-            binned.counts[bin] += 1;
-            binned.boxes[bin].grow(&prim.min, &prim.max);
+        if prims.len() < INTERLEAVED_BINNING {
+            let mut binned = Binned::empty();
+            for prim in prims {
+                binned.add(self.bin(prim), prim);
+            }
+            return binned;
         }
-        binned
+        let (mut even, mut odd) = (Binned::empty(), Binned::empty());
+        let mut pairs = prims.chunks_exact(2);
+        for pair in &mut pairs {
+            even.add(self.bin(&pair[0]), &pair[0]);
+            odd.add(self.bin(&pair[1]), &pair[1]);
+        }
+        if let [last] = pairs.remainder() {
+            even.add(self.bin(last), last);
+        }
+        even.merge(odd)
     }
 }
 
@@ -393,6 +420,12 @@ struct Binned {
 impl Binned {
     fn empty() -> Binned {
         Binned { counts: [0; BIN_COUNT], boxes: [Bounds::EMPTY; BIN_COUNT] }
+    }
+
+    #[inline(always)]
+    fn add(&mut self, bin: usize, prim: &Prim) {
+        self.counts[bin] += 1;
+        self.boxes[bin].grow(&prim.min, &prim.max);
     }
 
     /// Counts add and boxes unite exactly, so merging partial binnings in any order gives the

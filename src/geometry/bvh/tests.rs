@@ -31,7 +31,7 @@ fn wide_nodes_have_two_to_eight_children_and_keep_every_leaf() {
         .map(|i| Vec3::new((i * 37 % 101) as Real, (i * 11 % 13) as Real, (i % 7) as Real))
         .collect();
     let boxes = point_boxes(&points);
-    let (binary, _) = build::build(&boxes, LeafCost::PerPrimitive);
+    let (binary, _) = build::build(boxes.len(), |index| boxes[index], LeafCost::PerPrimitive);
     let bvh = Bvh::build(&boxes);
     let binary_leaves = binary.iter().filter(|node| node.is_leaf()).count();
     assert_eq!(bvh.leaf_count(), binary_leaves);

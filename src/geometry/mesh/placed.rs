@@ -22,8 +22,9 @@ impl Mesh {
         let bounds: Vec<Aabb> = corners.iter().map(|&c| Aabb::from_points(c)).collect();
         let (mut bvh, order) = Bvh::build_for(&bounds, LeafCost::PerPackOfFour).into_leaf_order();
         let ordered: Vec<[Vec3; 3]> = order.iter().map(|&i| corners[i as usize]).collect();
-        let flat = FlatLeaves::new(&bvh.leaves(), &ordered);
-        let packs = pack_leaves(&mut bvh, &ordered);
+        let leaves = bvh.leaves();
+        let flat = FlatLeaves::new(&leaves, &ordered);
+        let packs = pack_leaves(&mut bvh, &leaves, &ordered);
         // Normal 0 is the zero normal of triangles shaded with their geometric normal.
         let mut vertex_normals = vec![Vec3::ZERO];
         let normal_indices = order
