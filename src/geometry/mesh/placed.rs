@@ -19,8 +19,8 @@ impl Mesh {
         assert_eq!(corners.len(), normals.len(), "one normal triple (or None) per triangle");
         assert!(!corners.is_empty(), "a mesh has at least one triangle");
         let build_start = Instant::now();
-        let bounds: Vec<Aabb> = corners.iter().map(|&c| Aabb::from_points(c)).collect();
-        let (mut bvh, order) = Bvh::build_for(&bounds, LeafCost::PerPackOfFour).into_leaf_order();
+        let bounds_of = |index: usize| Aabb::from_points(corners[index]);
+        let (mut bvh, order) = Bvh::build_from(corners.len(), bounds_of, LeafCost::PerPackOfFour).into_leaf_order();
         let ordered: Vec<[Vec3; 3]> = order.iter().map(|&i| corners[i as usize]).collect();
         let leaves = bvh.leaves();
         let flat = FlatLeaves::new(&leaves, &ordered);
