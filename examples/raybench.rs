@@ -95,12 +95,14 @@ fn run(dir: &Path, mesh_name: &str, rays_name: &str, threads: usize) -> Result<S
     }
     .as_secs_f64();
 
-    // Rays from one point (a pinhole camera's) go in packets of eight, tiles of 4×2 pixels when
-    // they make a square image (as the Embree benchmark's packets), as a renderer traces camera
-    // rays; `RAYBENCH_PACKETS=0` traces them one by one.
+    // Rays go eight at a time through `Mesh::intersect_packet`, as the renderer's eight-lane
+    // integrator traces them: rays from one point (a pinhole camera's) in tiles of 4×2 pixels
+    // when they make a square image (as the Embree benchmark's packets), traced as packets;
+    // other rays each on its own way, the eight traversals interleaved.
+    // `RAYBENCH_PACKETS=0` traces them one by one through `Mesh::intersect`.
     let from_one_point = rays.iter().all(|ray| ray.origin == rays[0].origin);
-    let packets = from_one_point && std::env::var("RAYBENCH_PACKETS").map_or(true, |v| v != "0");
-    let rays = if packets { tiles(rays) } else { rays };
+    let packets = std::env::var("RAYBENCH_PACKETS").map_or(true, |v| v != "0");
+    let rays = if packets && from_one_point { tiles(rays) } else { rays };
     let mut t_out = vec![-1.0f32; rays.len()];
     let per_thread = rays.len().div_ceil(threads).next_multiple_of(8).max(8);
     let mut best = f64::INFINITY;

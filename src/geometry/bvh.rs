@@ -24,7 +24,7 @@ pub use box_set::BoxSet;
 pub use node::BvhNode;
 pub use build::LeafCost;
 pub use packet::{PACKET, PacketLanes, traverse_packet};
-pub use traverse::traverse;
+pub use traverse::{traverse, traverse_interleaved};
 
 /// Children per node: eight boxes are tested at once, one per SIMD lane.
 pub const WIDTH: usize = 8;

@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use super::aabb::Aabb;
 use super::huge_page_vec;
-use super::bvh::{Bvh, LeafCost, PACKET, PacketLanes, traverse, traverse_packet};
+use super::bvh::{Bvh, LeafCost, PACKET, PacketLanes, traverse, traverse_interleaved, traverse_packet};
 use super::triangle::{
     PackRay, RayLanes, TriangleHit, TrianglePack, face_normal, normalize,
     triangle_surface,
@@ -155,7 +155,8 @@ impl Mesh {
     /// [`Mesh::intersect`] returns for that ray. Rays that share the signs of their direction
     /// components and their dominant axis (camera rays through a small tile, say) are traced as
     /// a packet: each node and each triangle is tested against all of them at once. Others are
-    /// traced one by one.
+    /// traced each on its own way, their traversals interleaved so that their nodes are fetched
+    /// from memory together.
     ///
     /// # Panics
     /// If there are more than [`PACKET`] rays.
@@ -180,16 +181,38 @@ impl Mesh {
     #[inline(always)]
     pub fn closest_packet<I: Isa>(&self, rays: &[Ray], t_max: &[Real; PACKET]) -> [Option<MeshHit>; PACKET] {
         let (Some(slab), Some(triangle_rays)) = (PacketLanes::<I>::new(rays), RayLanes::<I>::new(rays)) else {
-            let mut closest = [None; PACKET];
-            for ((hit, ray), &t_max) in closest.iter_mut().zip(rays).zip(t_max) {
-                *hit = self.closest_lanes::<I>(ray, t_max);
-            }
-            return closest;
+            return self.closest_interleaved::<I>(rays, t_max);
         };
         let mut nearest = NearestTriangles { mesh: self, rays: triangle_rays, closest: [None; PACKET] };
         let mut t_limit = *t_max;
         traverse_packet::<I>(self.bvh.nodes(), &slab, (1u32 << rays.len()) - 1, &mut t_limit, &mut nearest);
         nearest.closest
+    }
+
+    /// [`Mesh::closest_packet`] of rays that do not make a packet: each ray's own traversal,
+    /// interleaved with the others' so that their nodes are fetched from memory together.
+    #[inline(always)]
+    fn closest_interleaved<I: Isa>(&self, rays: &[Ray], t_max: &[Real; PACKET]) -> [Option<MeshHit>; PACKET] {
+        let mut closest = [None; PACKET];
+        if rays.is_empty() {
+            return closest;
+        }
+        if self.flat.is_some() {
+            for ((hit, ray), &t_max) in closest.iter_mut().zip(rays).zip(t_max) {
+                *hit = self.closest_lanes::<I>(ray, t_max);
+            }
+            return closest;
+        }
+        // A loop rather than `array::from_fn`: a closure may be compiled outside the kernel.
+        let mut nearest = [NearestTriangle { mesh: self, ray: PackRay::<I>::new(&rays[0]), closest: None }; PACKET];
+        for (nearest, ray) in nearest[1..].iter_mut().zip(&rays[1..]) {
+            nearest.ray = PackRay::<I>::new(ray);
+        }
+        traverse_interleaved::<I, _>(self.bvh.nodes(), rays, t_max, &mut nearest);
+        for (hit, nearest) in closest.iter_mut().zip(&nearest) {
+            *hit = nearest.closest;
+        }
+        closest
     }
 
     /// Whether anything is hit in `(0, t_max]`; cheaper than [`Mesh::intersect`] because it

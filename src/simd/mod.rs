@@ -157,9 +157,24 @@ pub trait Kernel {
 /// Runs `kernel` on the current [`path`].
 #[inline]
 pub fn dispatch<K: Kernel>(kernel: K) -> K::Output {
-    match path() {
+    run_on(path(), kernel)
+}
+
+/// Runs `kernel` on `path` whatever the current one is, for a test that compares paths
+/// without changing the path of everything else running in the process.
+pub fn dispatch_on<K: Kernel>(path: SimdPath, kernel: K) -> Result<K::Output, UnsupportedPath> {
+    if !path.is_supported() {
+        return Err(UnsupportedPath(path));
+    }
+    Ok(run_on(path, kernel))
+}
+
+/// `kernel` on `path`, which the processor must support.
+#[inline(always)]
+fn run_on<K: Kernel>(path: SimdPath, kernel: K) -> K::Output {
+    match path {
         #[cfg(target_arch = "x86_64")]
-        // SAFETY: `path()` only returns a path the processor supports.
+        // SAFETY: both callers pass only paths the processor supports.
         SimdPath::Avx512 => unsafe { x86::run_avx512(kernel) },
         #[cfg(target_arch = "x86_64")]
         // SAFETY: as above.

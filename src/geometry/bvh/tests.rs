@@ -111,3 +111,81 @@ fn leaf_order_renumbers_primitives() {
     });
     assert_eq!(seen, vec![target]);
 }
+
+/// Records each leaf a traversal reaches with the limit it was reached under, and shrinks the
+/// limit as a closest-hit test would (to a distance made from the leaf), so that pruning by
+/// the limit takes part; stops at the `stop_at`-th leaf.
+#[derive(Clone)]
+struct LeafLog {
+    calls: Vec<(u32, u32, Real)>,
+    stop_at: usize,
+}
+
+impl<I: Isa> LeafVisitor<I> for LeafLog {
+    fn leaf(&mut self, first: u32, count: u32, t_limit: &mut Real) -> Visit {
+        self.calls.push((first, count, *t_limit));
+        *t_limit = t_limit.min(100.0 - (first % 17) as Real);
+        if self.calls.len() == self.stop_at { Visit::Stop } else { Visit::Continue }
+    }
+}
+
+/// Runs [`traverse`] for each ray alone and [`traverse_interleaved`] for them together.
+struct BothWays<'a> {
+    nodes: &'a [BvhNode],
+    rays: &'a [Ray],
+    t_max: [Real; PACKET],
+    stop_at: usize,
+}
+
+impl Kernel for BothWays<'_> {
+    type Output = (Vec<LeafLog>, Vec<LeafLog>);
+    fn run<I: Isa>(self) -> Self::Output {
+        let fresh = LeafLog { calls: Vec::new(), stop_at: self.stop_at };
+        let mut alone = vec![fresh.clone(); self.rays.len()];
+        for ((ray, log), &t_max) in self.rays.iter().zip(&mut alone).zip(&self.t_max) {
+            traverse::<I>(self.nodes, ray, t_max, log);
+        }
+        let mut together = vec![fresh; self.rays.len()];
+        traverse_interleaved::<I, _>(self.nodes, self.rays, &self.t_max, &mut together);
+        (alone, together)
+    }
+}
+
+#[test]
+fn interleaved_rays_each_visit_what_they_visit_alone() {
+    let points: Vec<Vec3> = (0..3000)
+        .map(|i| Vec3::new((i * 37 % 101) as Real, (i * 11 % 53) as Real, (i * 7 % 29) as Real))
+        .collect();
+    let boxes: Vec<Aabb> = points.iter().map(|&p| Aabb::new(p, p + Vec3::splat(3.0))).collect();
+    let bvh = Bvh::build(&boxes);
+    // Rays from all over, in every direction, one starting inside, one along an axis, one
+    // not finite (which visits nothing), and one whose limit ends before the boxes start.
+    let mut rays: Vec<Ray> = (0..7)
+        .map(|k| {
+            let k = k as Real;
+            let origin = Vec3::new(50.0 + 80.0 * (k * 1.3).sin(), 25.0 + 60.0 * (k * 0.7).cos(), -40.0 + 20.0 * k);
+            let target = Vec3::new(10.0 * k, 50.0 - 6.0 * k, 14.0);
+            Ray::new(origin, (target - origin).normalize())
+        })
+        .collect();
+    rays[3] = Ray::new(Vec3::new(50.0, 26.0, 14.0), Vec3::new(0.0, 0.0, -1.0));
+    rays.push(Ray::new(Vec3::new(Real::NAN, 0.0, 0.0), Vec3::X));
+    let mut t_max = [Real::INFINITY; PACKET];
+    t_max[5] = 1e-3;
+    for path in crate::simd::available() {
+        for stop_at in [usize::MAX, 3] {
+            for count in [rays.len(), 5, 1] {
+                let rays = &rays[..count];
+                let (alone, together) =
+                    crate::simd::dispatch_on(path, BothWays { nodes: bvh.nodes(), rays, t_max, stop_at }).unwrap();
+                if count > 2 {
+                    let reached = alone[2].calls.len();
+                    assert!(reached == stop_at || (stop_at > 3 && reached > 10), "{path:?}: ray 2 reached {reached} leaves");
+                }
+                for (k, (alone, together)) in alone.iter().zip(&together).enumerate() {
+                    assert_eq!(alone.calls, together.calls, "{path:?}, ray {k} of {count}, stop at {stop_at}");
+                }
+            }
+        }
+    }
+}

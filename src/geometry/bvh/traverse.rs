@@ -100,18 +100,28 @@ pub(super) fn sort_key(t: Real, lane: usize) -> u64 {
     key | lane as u64
 }
 
-/// The traversal stack: room for `STACK_SIZE` entries, the most any tree can need, and, unlike
-/// an array, not initialised (zeroing them for every ray would cost more than most rays push;
-/// a `Vec` would cost an allocation). A push never checks for room and a pop only for emptiness.
-pub(super) struct Stack<T> {
-    entries: [MaybeUninit<T>; STACK_SIZE],
+/// Room for a traversal stack's entries: `STACK_SIZE`, the most any tree can need, and, unlike
+/// an array of entries, not initialised (zeroing them for every ray would cost more than most
+/// rays push; a `Vec` would cost an allocation).
+pub(super) type StackSpace<T> = [MaybeUninit<T>; STACK_SIZE];
+
+/// An uninitialised [`StackSpace`].
+#[inline(always)]
+pub(super) const fn stack_space<T>() -> StackSpace<T> {
+    [const { MaybeUninit::uninit() }; STACK_SIZE]
+}
+
+/// A traversal stack in a [`StackSpace`] of the caller's, so that the stack itself is small
+/// enough to move. A push never checks for room and a pop only for emptiness.
+pub(super) struct Stack<'a, T> {
+    entries: &'a mut StackSpace<T>,
     len: usize,
 }
 
-impl<T: Copy> Stack<T> {
+impl<'a, T: Copy> Stack<'a, T> {
     #[inline(always)]
-    pub(super) fn new() -> Self {
-        Stack { entries: [const { MaybeUninit::uninit() }; STACK_SIZE], len: 0 }
+    pub(super) fn new(space: &'a mut StackSpace<T>) -> Self {
+        Stack { entries: space, len: 0 }
     }
 
     #[inline(always)]
@@ -155,70 +165,156 @@ fn fetch<I: Isa>(nodes: &[BvhNode], pending: &Pending, visitor: &impl LeafVisito
 /// A kernel: compile it only inside one (see `crate::simd`).
 #[inline(always)]
 pub fn traverse<I: Isa>(nodes: &[BvhNode], ray: &Ray, t_max: Real, visitor: &mut impl LeafVisitor<I>) {
-    if nodes.is_empty() || !(ray.origin.is_finite() && ray.direction.is_finite()) {
-        return;
+    let mut space = stack_space();
+    let Some(mut walk) = Walk::<I>::new(nodes, ray, t_max, &mut space) else { return };
+    while walk.step::<false>(nodes, visitor) {}
+}
+
+/// [`traverse`] for up to [`PACKET`] rays that need not have anything in common (the random
+/// rays of a path, the reflections off a bumpy surface), ray `k` with its own `t_max[k]` and
+/// `visitors[k]`. Their traversals are interleaved, a node or leaf of each in turn, and each
+/// asks for the next node or leaf it will visit from memory before the others take their
+/// turn: where one ray's traversal would wait for each node to arrive, several rays' nodes are
+/// on their way at once. Each ray visits exactly the nodes and leaves, in the same order, that
+/// [`traverse`] visits for it alone, so its visitor sees the same calls.
+///
+/// A kernel: compile it only inside one (see `crate::simd`).
+///
+/// # Panics
+/// If there are more than [`PACKET`] rays, or fewer visitors than rays.
+#[inline(always)]
+pub fn traverse_interleaved<I: Isa, V: LeafVisitor<I>>(
+    nodes: &[BvhNode],
+    rays: &[Ray],
+    t_max: &[Real; PACKET],
+    visitors: &mut [V],
+) {
+    assert!(rays.len() <= PACKET && visitors.len() >= rays.len(), "up to {PACKET} rays, a visitor each");
+    // SAFETY: an array of `MaybeUninit` needs no initialisation (a repeated `stack_space()`
+    // would be written out with zeros).
+    let mut spaces: [StackSpace<Pending>; PACKET] = unsafe { MaybeUninit::uninit().assume_init() };
+    let mut walks = [const { None }; PACKET];
+    let mut active = 0u32;
+    // Loops rather than `array::from_fn`: a closure may be compiled outside the kernel,
+    // without its instructions.
+    for (k, (space, ray)) in spaces.iter_mut().zip(rays).enumerate() {
+        walks[k] = Walk::<I>::new(nodes, ray, t_max[k], space);
+        active |= (walks[k].is_some() as u32) << k;
     }
-    let slab = SlabLanes::<I>::new(ray);
-    let mut t_limit = t_max;
-    let mut stack = Stack::<Pending>::new();
-    let mut current = Pending { t: 0.0, index: 0, count: 0 };
-    loop {
+    while active != 0 {
+        let mut turn = active;
+        while turn != 0 {
+            let k = turn.trailing_zeros() as usize;
+            turn &= turn - 1;
+            let Some(walk) = walks[k].as_mut() else { continue };
+            if !walk.step::<true>(nodes, &mut visitors[k]) {
+                active &= !(1 << k);
+            }
+        }
+    }
+}
+
+/// One ray's traversal under way: the ray's slab terms, its limit, what it visits next and the
+/// children waiting.
+struct Walk<'a, I: Isa> {
+    slab: SlabLanes<I>,
+    t_limit: Real,
+    current: Pending,
+    stack: Stack<'a, Pending>,
+}
+
+impl<'a, I: Isa> Walk<'a, I> {
+    /// `None` when there is nothing to traverse or the ray is not finite.
+    #[inline(always)]
+    fn new(nodes: &[BvhNode], ray: &Ray, t_max: Real, space: &'a mut StackSpace<Pending>) -> Option<Self> {
+        if nodes.is_empty() || !(ray.origin.is_finite() && ray.direction.is_finite()) {
+            return None;
+        }
+        Some(Walk {
+            slab: SlabLanes::<I>::new(ray),
+            t_limit: t_max,
+            current: Pending { t: 0.0, index: 0, count: 0 },
+            stack: Stack::new(space),
+        })
+    }
+
+    /// Visits the current node or leaf and moves on to the next; `false` when the traversal is
+    /// over. With `AHEAD`, the next node or leaf is asked for from memory, for a caller that
+    /// has other work to do before the next step.
+    #[inline(always)]
+    fn step<const AHEAD: bool>(&mut self, nodes: &[BvhNode], visitor: &mut impl LeafVisitor<I>) -> bool {
+        let current = self.current;
         if current.count == 0 {
             let node = &nodes[current.index as usize];
-            let (t_enter, hits) = node_hits::<I>(node, &slab, t_limit);
+            let (t_enter, hits) = node_hits::<I>(node, &self.slab, self.t_limit);
             if hits != 0 {
-                let first = hits.trailing_zeros() as usize;
-                let rest = hits & (hits - 1);
-                if rest == 0 {
-                    current = Pending { t: 0.0, index: node.child[first], count: node.count[first] as u32 };
-                    continue;
+                self.current = nearest_child::<I>(node, t_enter, hits, nodes, &mut self.stack, visitor);
+                if AHEAD {
+                    fetch::<I>(nodes, &self.current, visitor);
                 }
-                let mut t = [0.0; WIDTH];
-                t_enter.store(&mut t);
-                let child = |lane: usize| Pending { t: t[lane], index: node.child[lane], count: node.count[lane] as u32 };
-                if rest & (rest - 1) == 0 {
-                    // Two children, the common case: the farther one waits.
-                    let second = rest.trailing_zeros() as usize;
-                    let (near, far) = if t[second] < t[first] { (second, first) } else { (first, second) };
-                    fetch::<I>(nodes, &child(far), visitor);
-                    stack.push(child(far));
-                    current = child(near);
-                    continue;
-                }
-                // More: sort keys that order by entry distance and carry the lane, nearest first.
-                let mut keys = [0u64; WIDTH];
-                let mut len = 0;
-                let mut remaining = hits;
-                while remaining != 0 {
-                    let lane = remaining.trailing_zeros() as usize;
-                    remaining &= remaining - 1;
-                    let key = sort_key(t[lane], lane);
-                    let mut k = len;
-                    while k > 0 && keys[k - 1] > key {
-                        keys[k] = keys[k - 1];
-                        k -= 1;
-                    }
-                    keys[k] = key;
-                    len += 1;
-                }
-                for &key in keys[1..len].iter().rev() {
-                    let waiting = child(key as usize & (WIDTH - 1));
-                    fetch::<I>(nodes, &waiting, visitor);
-                    stack.push(waiting);
-                }
-                current = child(keys[0] as usize & (WIDTH - 1));
-                continue;
+                return true;
             }
-        } else if let Visit::Stop = visitor.leaf(current.index, current.count, &mut t_limit) {
-            return;
+        } else if let Visit::Stop = visitor.leaf(current.index, current.count, &mut self.t_limit) {
+            return false;
         }
         loop {
-            let Some(pending) = stack.pop() else { return };
+            let Some(pending) = self.stack.pop() else { return false };
             // The box was hit before `t_limit` shrank; entered beyond it, it holds nothing nearer.
-            if pending.t <= t_limit * BOX_SLACK {
-                current = pending;
-                break;
+            if pending.t <= self.t_limit * BOX_SLACK {
+                self.current = pending;
+                return true;
             }
         }
     }
+}
+
+/// Of a node's children the ray enters (`hits`, entered at `t_enter`), the nearest, which is
+/// visited next; the others are pushed on the stack, farthest first, and fetched meanwhile.
+#[inline(always)]
+fn nearest_child<I: Isa>(
+    node: &BvhNode,
+    t_enter: R8<I>,
+    hits: u32,
+    nodes: &[BvhNode],
+    stack: &mut Stack<'_, Pending>,
+    visitor: &impl LeafVisitor<I>,
+) -> Pending {
+    let first = hits.trailing_zeros() as usize;
+    let rest = hits & (hits - 1);
+    if rest == 0 {
+        return Pending { t: 0.0, index: node.child[first], count: node.count[first] as u32 };
+    }
+    let mut t = [0.0; WIDTH];
+    t_enter.store(&mut t);
+    let child = |lane: usize| Pending { t: t[lane], index: node.child[lane], count: node.count[lane] as u32 };
+    if rest & (rest - 1) == 0 {
+        // Two children, the common case: the farther one waits.
+        let second = rest.trailing_zeros() as usize;
+        let (near, far) = if t[second] < t[first] { (second, first) } else { (first, second) };
+        fetch::<I>(nodes, &child(far), visitor);
+        stack.push(child(far));
+        return child(near);
+    }
+    // More: sort keys that order by entry distance and carry the lane, nearest first.
+    let mut keys = [0u64; WIDTH];
+    let mut len = 0;
+    let mut remaining = hits;
+    while remaining != 0 {
+        let lane = remaining.trailing_zeros() as usize;
+        remaining &= remaining - 1;
+        let key = sort_key(t[lane], lane);
+        let mut k = len;
+        while k > 0 && keys[k - 1] > key {
+            keys[k] = keys[k - 1];
+            k -= 1;
+        }
+        keys[k] = key;
+        len += 1;
+    }
+    for &key in keys[1..len].iter().rev() {
+        let waiting = child(key as usize & (WIDTH - 1));
+        fetch::<I>(nodes, &waiting, visitor);
+        stack.push(waiting);
+    }
+    child(keys[0] as usize & (WIDTH - 1))
 }

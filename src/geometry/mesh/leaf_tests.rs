@@ -9,6 +9,7 @@ use crate::simd::{Isa, Lanes};
 
 /// The leaf test of [`Mesh::intersect`]: each pack of the leaf, keeping the nearest hit (the
 /// smaller triangle index among hits at the same `t`).
+#[derive(Clone, Copy)]
 pub(super) struct NearestTriangle<'a, I: Isa> {
     pub(super) mesh: &'a Mesh,
     pub(super) ray: PackRay<I>,

@@ -53,6 +53,7 @@ impl TrianglePack {
 }
 
 /// [`TriangleRay`] splatted across the lanes of a pack test.
+#[derive(Clone, Copy)]
 pub struct PackRay<I: Isa> {
     /// Which axes become x, y and z (the permutation of [`TriangleRay`]).
     axes: [usize; 3],
