@@ -146,11 +146,7 @@ impl<'a> WhittedLanes<'a> {
         match &self.scene.background {
             Background::Color(color) => V3::splat(*color),
             Background::CubeMap(map) => {
-                let directions = rays.direction.vectors();
-                let seen: [Vec3; LANES] = std::array::from_fn(|k| {
-                    if missed & (1 << k) != 0 { map.radiance(directions[k]) } else { Vec3::ZERO }
-                });
-                V3::gather(&seen)
+                V3::gather(&map.radiance_lanes::<I, LANES>(&rays.direction.vectors(), missed))
             }
         }
     }

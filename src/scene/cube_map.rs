@@ -10,6 +10,7 @@ use rayon::prelude::*;
 
 use super::real::{Color, Real, Vec3};
 pub use crate::build_error::CubeMapError;
+use crate::simd::Isa;
 
 /// One face: a PNG read and checked at load, decoded when a ray first looks at it.
 ///
@@ -60,6 +61,38 @@ impl CubeMap {
     }
 
     pub fn radiance(&self, direction: Vec3) -> Color {
+        self.spot(direction).map_or(Color::ZERO, |spot| self.faces[spot.face].bilinear(&spot))
+    }
+
+    /// [`CubeMap::radiance`] of the directions whose bit is set in `wanted` (the others see
+    /// black), each exactly as alone. Every texel is asked for from memory before any is read:
+    /// the reflections off a curved surface look all over the map, and lookups one after another
+    /// would each wait for their texels in turn.
+    ///
+    /// A kernel: compile it only inside one (see `crate::simd`).
+    #[inline(always)]
+    pub fn radiance_lanes<I: Isa, const N: usize>(&self, directions: &[Vec3; N], wanted: u32) -> [Color; N] {
+        let mut spots = [None; N];
+        for (k, spot) in spots.iter_mut().enumerate() {
+            if wanted >> k & 1 != 0 {
+                *spot = self.spot(directions[k]);
+                if let Some(spot) = spot {
+                    self.faces[spot.face].prefetch::<I>(spot);
+                }
+            }
+        }
+        let mut seen = [Color::ZERO; N];
+        for (seen, spot) in seen.iter_mut().zip(&spots) {
+            if let Some(spot) = spot {
+                *seen = self.faces[spot.face].bilinear(spot);
+            }
+        }
+        seen
+    }
+
+    /// Where `direction` looks: its face and the texels it blends, or `None` for a direction
+    /// that is zero or not finite (which sees black).
+    fn spot(&self, direction: Vec3) -> Option<Spot> {
         let d = direction.normalize_or_zero();
         let (x, y, z) = (d.x, d.y, d.z);
         let (ax, ay, az) = (x.abs(), y.abs(), z.abs());
@@ -74,9 +107,9 @@ impl CubeMap {
             (BACK, half(x, z), 1.0 - half(y, z))
         };
         if !(u.is_finite() && v.is_finite()) {
-            return Color::ZERO;
+            return None;
         }
-        self.faces[face].bilinear(u, v)
+        Some(self.faces[face].spot(face, u, v))
     }
 
     /// Decodes every face now instead of when first seen (for a scene rendered many times).
@@ -122,27 +155,64 @@ impl Face {
         texels.as_deref().ok()
     }
 
-    fn bilinear(&self, u: Real, v: Real) -> Color {
-        let Some(texels) = self.texels() else { return Color::ZERO };
-        let values = byte_values();
+    /// The four texels a lookup at `(u, v)` blends, with the reference's edge-clamped indices,
+    /// and their weights' fractions.
+    fn spot(&self, face: usize, u: Real, v: Real) -> Spot {
         let x = u * self.width as Real;
         let y = (1.0 - v) * self.height as Real;
         // `u` and `v` lie in [0, 1] (a component over the largest one, plus one, halved), so `x`
         // and `y` are non-negative and truncation is `floor`, without the library call `floor`
         // is on x86-64 without SSE4.1.
         let (x0, y0) = (x as usize as Real, y as usize as Real);
-        let (alpha, beta) = (x - x0, y - y0);
         let texel = |dx: Real, dy: Real| {
             let column = ((x0 + dx).max(0.0) as usize).min(self.width - 1);
             let row = ((y0 + dy).max(0.0) as usize).min(self.height - 1);
-            let texel = &texels[3 * (row * self.width + column)..][..3];
+            3 * (row * self.width + column)
+        };
+        Spot {
+            face,
+            texels: [texel(0.0, 0.0), texel(1.0, 0.0), texel(0.0, 1.0), texel(1.0, 1.0)],
+            alpha: x - x0,
+            beta: y - y0,
+        }
+    }
+
+    /// Asks for the cache lines of `spot`'s texels (a hint: it changes nothing).
+    #[inline(always)]
+    fn prefetch<I: Isa>(&self, spot: &Spot) {
+        if let Some(texels) = self.texels() {
+            for &offset in &spot.texels {
+                // The last byte too: a texel's three may straddle two lines.
+                I::prefetch(texels.as_ptr().wrapping_add(offset));
+                I::prefetch(texels.as_ptr().wrapping_add(offset + 2));
+            }
+        }
+    }
+
+    fn bilinear(&self, spot: &Spot) -> Color {
+        let Some(texels) = self.texels() else { return Color::ZERO };
+        let values = byte_values();
+        let (alpha, beta) = (spot.alpha, spot.beta);
+        let texel = |corner: usize| {
+            let texel = &texels[spot.texels[corner]..][..3];
             Color::new(values[texel[0] as usize], values[texel[1] as usize], values[texel[2] as usize])
         };
-        texel(0.0, 0.0) * ((1.0 - alpha) * (1.0 - beta))
-            + texel(1.0, 0.0) * (alpha * (1.0 - beta))
-            + texel(0.0, 1.0) * ((1.0 - alpha) * beta)
-            + texel(1.0, 1.0) * (alpha * beta)
+        texel(0) * ((1.0 - alpha) * (1.0 - beta))
+            + texel(1) * (alpha * (1.0 - beta))
+            + texel(2) * ((1.0 - alpha) * beta)
+            + texel(3) * (alpha * beta)
     }
+}
+
+/// Where a lookup reads: a face, the byte offsets of the four texels it blends (the texel
+/// the direction falls in, the next column, the next row, and both) and the fractions `alpha`
+/// and `beta` of the way to the next column and row.
+#[derive(Clone, Copy)]
+struct Spot {
+    face: usize,
+    texels: [usize; 4],
+    alpha: Real,
+    beta: Real,
 }
 
 /// A face's texels as RGB bytes. An 8-bit RGB PNG (the course's faces) is decoded by the `png`
@@ -235,16 +305,16 @@ mod tests {
         // Columns 0..3 hold 0, 0.2, 0.4, 0.6 on every row.
         let face = face(4, 1, (0..4).map(|i| [i * 51; 3]).collect());
         // u = 0.3 → X = 1.2 → 0.8·texel(1) + 0.2·texel(2).
-        assert!((face.bilinear(0.3, 0.5).x - (0.8 * 0.2 + 0.2 * 0.4)).abs() < 1e-6);
+        assert!((face.bilinear(&face.spot(0, 0.3, 0.5)).x - (0.8 * 0.2 + 0.2 * 0.4)).abs() < 1e-6);
         // Past the last column the index clamps to the edge.
-        assert!((face.bilinear(0.99, 0.5).x - 0.6).abs() < 1e-6);
+        assert!((face.bilinear(&face.spot(0, 0.99, 0.5)).x - 0.6).abs() < 1e-6);
     }
 
     #[test]
     fn v_counts_up_from_the_bottom_row() {
         let face = face(1, 2, vec![[255; 3], [0; 3]]);
-        assert!(face.bilinear(0.5, 0.99).x > 0.9, "v near 1 is the top row");
-        assert!(face.bilinear(0.5, 0.01).x < 0.1, "v near 0 is the bottom row");
+        assert!(face.bilinear(&face.spot(0, 0.5, 0.99)).x > 0.9, "v near 1 is the top row");
+        assert!(face.bilinear(&face.spot(0, 0.5, 0.01)).x < 0.1, "v near 0 is the bottom row");
     }
 
     #[test]
@@ -295,5 +365,29 @@ mod tests {
         let error = map.failure().expect("the right face could not be decoded");
         assert!(error.path.ends_with("right.png"), "{error}");
         assert!(map.decode_all().is_err());
+    }
+
+    #[test]
+    fn lookups_side_by_side_see_what_each_sees_alone() {
+        // Faces of 3×2 texels, every texel different, so that each weight shows.
+        let faces = std::array::from_fn(|f| face(3, 2, (0..6).map(|i| [(40 * f + 7 * i) as u8, (i * 31) as u8, 200]).collect()));
+        let map = CubeMap { faces };
+        let directions = [
+            Vec3::new(2.0, 0.3, -0.7),
+            Vec3::new(-0.2, -1.0, 0.45),
+            Vec3::ZERO,
+            Vec3::new(0.1, 0.2, 3.0),
+            Vec3::new(-0.5, 0.5, -1.0),
+            Vec3::new(Real::NAN, 1.0, 0.0),
+            Vec3::new(-4.0, 1.0, 2.0),
+            Vec3::new(0.3, 5.0, -0.2),
+        ];
+        let wanted = 0b1101_1111;
+        let seen = map.radiance_lanes::<crate::simd::Portable, 8>(&directions, wanted);
+        for (k, (&direction, seen)) in directions.iter().zip(seen).enumerate() {
+            let alone = if wanted >> k & 1 != 0 { map.radiance(direction) } else { Color::ZERO };
+            assert_eq!(seen, alone, "lane {k}");
+        }
+        assert!(seen.iter().filter(|color| color.x > 0.0).count() >= 5);
     }
 }
