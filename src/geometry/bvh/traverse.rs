@@ -296,21 +296,7 @@ fn nearest_child<I: Isa>(
         return child(near);
     }
     // More: sort keys that order by entry distance and carry the lane, nearest first.
-    let mut keys = [0u64; WIDTH];
-    let mut len = 0;
-    let mut remaining = hits;
-    while remaining != 0 {
-        let lane = remaining.trailing_zeros() as usize;
-        remaining &= remaining - 1;
-        let key = sort_key(t[lane], lane);
-        let mut k = len;
-        while k > 0 && keys[k - 1] > key {
-            keys[k] = keys[k - 1];
-            k -= 1;
-        }
-        keys[k] = key;
-        len += 1;
-    }
+    let (keys, len) = BoxSet::nearest_first(hits, &t);
     for &key in keys[1..len].iter().rev() {
         let waiting = child(key as usize & (WIDTH - 1));
         fetch::<I>(nodes, &waiting, visitor);
