@@ -61,7 +61,7 @@ impl CubeMap {
     }
 
     pub fn radiance(&self, direction: Vec3) -> Color {
-        self.spot(direction).map_or(Color::ZERO, |spot| self.faces[spot.face].bilinear(&spot))
+        self.spot(direction).map_or(Color::ZERO, |(face, spot)| self.faces[face].bilinear(&spot))
     }
 
     /// [`CubeMap::radiance`] of the directions whose bit is set in `wanted` (the others see
@@ -76,23 +76,23 @@ impl CubeMap {
         for (k, spot) in spots.iter_mut().enumerate() {
             if wanted >> k & 1 != 0 {
                 *spot = self.spot(directions[k]);
-                if let Some(spot) = spot {
-                    self.faces[spot.face].prefetch::<I>(spot);
+                if let Some((face, spot)) = spot {
+                    self.faces[*face].prefetch::<I>(spot);
                 }
             }
         }
         let mut seen = [Color::ZERO; N];
         for (seen, spot) in seen.iter_mut().zip(&spots) {
-            if let Some(spot) = spot {
-                *seen = self.faces[spot.face].bilinear(spot);
+            if let Some((face, spot)) = spot {
+                *seen = self.faces[*face].bilinear(spot);
             }
         }
         seen
     }
 
-    /// Where `direction` looks: its face and the texels it blends, or `None` for a direction
-    /// that is zero or not finite (which sees black).
-    fn spot(&self, direction: Vec3) -> Option<Spot> {
+    /// Where `direction` looks: its face (an index into `faces`) and the texels it blends there,
+    /// or `None` for a direction that is zero or not finite (which sees black).
+    fn spot(&self, direction: Vec3) -> Option<(usize, Spot)> {
         let d = direction.normalize_or_zero();
         let (x, y, z) = (d.x, d.y, d.z);
         let (ax, ay, az) = (x.abs(), y.abs(), z.abs());
@@ -109,7 +109,7 @@ impl CubeMap {
         if !(u.is_finite() && v.is_finite()) {
             return None;
         }
-        Some(self.faces[face].spot(face, u, v))
+        Some((face, self.faces[face].spot(u, v)))
     }
 
     /// Decodes every face now instead of when first seen (for a scene rendered many times).
@@ -157,7 +157,7 @@ impl Face {
 
     /// The four texels a lookup at `(u, v)` blends, with the reference's edge-clamped indices,
     /// and their weights' fractions.
-    fn spot(&self, face: usize, u: Real, v: Real) -> Spot {
+    fn spot(&self, u: Real, v: Real) -> Spot {
         let x = u * self.width as Real;
         let y = (1.0 - v) * self.height as Real;
         // `u` and `v` lie in [0, 1] (a component over the largest one, plus one, halved), so `x`
@@ -170,7 +170,6 @@ impl Face {
             3 * (row * self.width + column)
         };
         Spot {
-            face,
             texels: [texel(0.0, 0.0), texel(1.0, 0.0), texel(0.0, 1.0), texel(1.0, 1.0)],
             alpha: x - x0,
             beta: y - y0,
@@ -204,12 +203,11 @@ impl Face {
     }
 }
 
-/// Where a lookup reads: a face, the byte offsets of the four texels it blends (the texel
+/// Where a lookup reads on its face: the byte offsets of the four texels it blends (the texel
 /// the direction falls in, the next column, the next row, and both) and the fractions `alpha`
 /// and `beta` of the way to the next column and row.
 #[derive(Clone, Copy)]
 struct Spot {
-    face: usize,
     texels: [usize; 4],
     alpha: Real,
     beta: Real,
@@ -305,16 +303,16 @@ mod tests {
         // Columns 0..3 hold 0, 0.2, 0.4, 0.6 on every row.
         let face = face(4, 1, (0..4).map(|i| [i * 51; 3]).collect());
         // u = 0.3 → X = 1.2 → 0.8·texel(1) + 0.2·texel(2).
-        assert!((face.bilinear(&face.spot(0, 0.3, 0.5)).x - (0.8 * 0.2 + 0.2 * 0.4)).abs() < 1e-6);
+        assert!((face.bilinear(&face.spot(0.3, 0.5)).x - (0.8 * 0.2 + 0.2 * 0.4)).abs() < 1e-6);
         // Past the last column the index clamps to the edge.
-        assert!((face.bilinear(&face.spot(0, 0.99, 0.5)).x - 0.6).abs() < 1e-6);
+        assert!((face.bilinear(&face.spot(0.99, 0.5)).x - 0.6).abs() < 1e-6);
     }
 
     #[test]
     fn v_counts_up_from_the_bottom_row() {
         let face = face(1, 2, vec![[255; 3], [0; 3]]);
-        assert!(face.bilinear(&face.spot(0, 0.5, 0.99)).x > 0.9, "v near 1 is the top row");
-        assert!(face.bilinear(&face.spot(0, 0.5, 0.01)).x < 0.1, "v near 0 is the bottom row");
+        assert!(face.bilinear(&face.spot(0.5, 0.99)).x > 0.9, "v near 1 is the top row");
+        assert!(face.bilinear(&face.spot(0.5, 0.01)).x < 0.1, "v near 0 is the bottom row");
     }
 
     #[test]
