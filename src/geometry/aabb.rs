@@ -7,7 +7,7 @@ use super::real::{Real, Vec3, gamma};
 ///
 /// The empty box has `min = +∞` and `max = −∞`, so it is the identity of [`Aabb::union`] and
 /// a ray can never hit it.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Zeroable)]
 pub struct Aabb {
     pub min: Vec3,
     pub max: Vec3,

@@ -103,7 +103,8 @@ impl Mesh {
         let build_start = Instant::now();
         let bounds_of = |index: usize| Aabb::from_points(corners_of(triangles[index]));
         let (mut bvh, order) = Bvh::build_from(triangles.len(), bounds_of, LeafCost::PerPackOfFour).into_leaf_order();
-        let corners: Vec<[Vec3; 3]> = order.par_iter().map(|&i| corners_of(triangles[i as usize])).collect();
+        let mut corners: Vec<[Vec3; 3]> = huge_page_vec(order.len());
+        corners.par_extend(order.par_iter().map(|&i| corners_of(triangles[i as usize])));
         let leaves = bvh.leaves();
         let flat = FlatLeaves::new(&leaves, &corners);
         let packs = pack_leaves(&mut bvh, &leaves, &corners);

@@ -2,8 +2,8 @@
 //! tree that is traversed.
 //!
 //! Every split decision is a pure function of the primitives in the node, and subtrees built in
-//! parallel are stitched together in a fixed order, so the result does not depend on how rayon
-//! schedules the work.
+//! parallel write their nodes into slots fixed before they are built, so the result does not
+//! depend on how rayon schedules the work.
 //!
 //! Each node costs two passes over its primitives: binning (which also gives both children's
 //! boxes, as unions of bins) and partitioning (which also gives both children's centroid
@@ -12,6 +12,7 @@
 use rayon::prelude::*;
 
 use super::super::aabb::Aabb;
+use super::super::huge_page_vec;
 use super::super::real::{Real, Vec3};
 
 /// Twelve bins find splits within a few percent of a full sweep at a fraction of its cost.
@@ -23,8 +24,8 @@ const MAX_LEAF_PRIMS: usize = 4;
 /// whose traversal is bound by memory traffic.
 const TRAVERSAL_COST: Real = 1.0;
 /// Below this many primitives a subtree is cheaper to build on the current thread than to
-/// hand to rayon and stitch back.
-const PARALLEL_THRESHOLD: usize = 4096;
+/// hand to rayon.
+pub(super) const PARALLEL_THRESHOLD: usize = 4096;
 /// From this many primitives a node's binning pass is itself split among threads (the first
 /// levels of the tree, before there are subtrees enough to keep every thread busy).
 const PARALLEL_BINNING: usize = 1 << 17;
@@ -67,7 +68,7 @@ impl LeafCost {
 
 /// One node of the binary tree. Nodes are stored depth first: an interior node's first child
 /// immediately follows it, so only the second child's index needs storing.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, bytemuck::Zeroable)]
 pub(super) struct BinaryNode {
     pub bounds: Aabb,
     /// `bounds.surface_area()`, which the collapse compares many times.
@@ -93,19 +94,22 @@ impl BinaryNode {
 }
 
 /// Returns the nodes in depth-first order and the primitive indices in leaf order, for the
-/// `count` primitives whose boxes are `bounds_of(0..count)`.
+/// `count` primitives whose boxes are `bounds_of(0..count)`. The nodes are `2·count − 1` slots
+/// (see [`build_parallel`]), the root first; slots no node is stored in are zeroed, and no
+/// node points at them.
 pub(super) fn build(count: usize, bounds_of: impl Fn(usize) -> Aabb + Sync, cost: LeafCost) -> (Vec<BinaryNode>, Vec<u32>) {
     assert!(u32::try_from(count).is_ok(), "a BVH holds at most u32::MAX primitives");
     if count == 0 {
         return (Vec::new(), Vec::new());
     }
-    let mut prims: Vec<Prim> = Vec::with_capacity(count);
+    let mut prims: Vec<Prim> = huge_page_vec(count);
     prims.par_extend((0..count).into_par_iter().map(|index| Prim::new(&bounds_of(index), index)));
     let root = Extent::of_parallel(&prims);
-    let subtree = build_parallel(Node { prims: &mut prims, extent: root, first: 0, depth: 0 }, cost);
-    let mut nodes = Vec::new();
-    flatten(subtree, &mut nodes);
-    (nodes, prims.iter().map(|prim| prim.index).collect())
+    // Zeroed memory from the allocator: slots no subtree fills are never written, so their pages
+    // never cost a fault.
+    let mut nodes = bytemuck::zeroed_vec(2 * count - 1);
+    build_parallel(Node { prims: &mut prims, extent: root, first: 0, depth: 0 }, &mut nodes, 0, cost);
+    (nodes, prims.par_iter().map(|prim| prim.index).collect())
 }
 
 /// A primitive as the build moves it around. Partitioning these records in place, rather than
@@ -235,73 +239,65 @@ enum Plan {
     Split { mid: usize, below: Extent, above: Extent },
 }
 
-/// A subtree as returned by a parallel task: either a finished run of nodes (child indices
-/// relative to the run's start) or a split whose children were built separately.
-enum Subtree {
-    Nodes(Vec<BinaryNode>),
-    Split {
-        bounds: Aabb,
-        children: Box<(Subtree, Subtree)>,
-    },
-}
-
-fn build_parallel(node: Node, cost: LeafCost) -> Subtree {
+/// Builds `node` into `slots`, the first of which is binary node `base`: the node itself first,
+/// then its first child's subtree, then its second child's. A node of `n` primitives has `2n − 1`
+/// slots, as many nodes as its subtree can have (leaves are never empty), so each child's slots
+/// are known before it is built: the first child of a split at `mid` takes the `2·mid − 1`
+/// slots after its parent and the second child the rest. Subtrees built in parallel therefore
+/// write their nodes straight into place, and the tree is the same on any number of threads.
+fn build_parallel(node: Node, slots: &mut [BinaryNode], base: usize, cost: LeafCost) {
     if node.prims.len() < PARALLEL_THRESHOLD {
-        let mut nodes = Vec::with_capacity(node.prims.len());
-        build_serial(node, cost, &mut nodes);
-        return Subtree::Nodes(nodes);
+        build_serial(node, &mut Run { slots, base, len: 0 }, cost);
+        return;
     }
     let bounds = node.extent.bounds.aabb();
     match plan(node.prims, node.extent, node.depth, cost) {
-        Plan::Leaf => Subtree::Nodes(vec![BinaryNode::leaf(bounds, node.first, node.prims.len())]),
+        Plan::Leaf => slots[0] = BinaryNode::leaf(bounds, node.first, node.prims.len()),
         Plan::Split { mid, below, above } => {
+            slots[0] = BinaryNode::interior(bounds);
+            slots[0].offset = (base + 2 * mid) as u32;
+            let (below_slots, above_slots) = slots[1..].split_at_mut(2 * mid - 1);
             let (below_prims, above_prims) = node.prims.split_at_mut(mid);
             let depth = node.depth + 1;
-            let children = rayon::join(
-                || build_parallel(Node { prims: below_prims, extent: below, first: node.first, depth }, cost),
-                || build_parallel(Node { prims: above_prims, extent: above, first: node.first + mid, depth }, cost),
+            rayon::join(
+                || build_parallel(Node { prims: below_prims, extent: below, first: node.first, depth }, below_slots, base + 1, cost),
+                || build_parallel(Node { prims: above_prims, extent: above, first: node.first + mid, depth }, above_slots, base + 2 * mid, cost),
             );
-            Subtree::Split { bounds, children: Box::new(children) }
         }
     }
 }
 
-fn build_serial(node: Node, cost: LeafCost, nodes: &mut Vec<BinaryNode>) {
+/// A subtree's slots as one thread fills them, depth first from the start: the rest stay unused.
+struct Run<'a> {
+    slots: &'a mut [BinaryNode],
+    /// The binary node index of `slots[0]`.
+    base: usize,
+    /// How many slots are filled.
+    len: usize,
+}
+
+impl Run<'_> {
+    /// Fills the next slot; returns its index in the whole tree.
+    fn push(&mut self, node: BinaryNode) -> usize {
+        self.slots[self.len] = node;
+        self.len += 1;
+        self.base + self.len - 1
+    }
+}
+
+fn build_serial(node: Node, run: &mut Run, cost: LeafCost) {
     let bounds = node.extent.bounds.aabb();
     match plan(node.prims, node.extent, node.depth, cost) {
-        Plan::Leaf => nodes.push(BinaryNode::leaf(bounds, node.first, node.prims.len())),
+        Plan::Leaf => {
+            run.push(BinaryNode::leaf(bounds, node.first, node.prims.len()));
+        }
         Plan::Split { mid, below, above } => {
-            let index = nodes.len();
-            nodes.push(BinaryNode::interior(bounds));
+            let index = run.push(BinaryNode::interior(bounds));
             let (below_prims, above_prims) = node.prims.split_at_mut(mid);
             let depth = node.depth + 1;
-            build_serial(Node { prims: below_prims, extent: below, first: node.first, depth }, cost, nodes);
-            nodes[index].offset = nodes.len() as u32;
-            build_serial(Node { prims: above_prims, extent: above, first: node.first + mid, depth }, cost, nodes);
-        }
-    }
-}
-
-/// Appends the subtree in depth-first order, rebasing the relative child indices of each
-/// serially built run.
-fn flatten(subtree: Subtree, nodes: &mut Vec<BinaryNode>) {
-    match subtree {
-        Subtree::Nodes(run) => {
-            let base = nodes.len() as u32;
-            nodes.extend(run.into_iter().map(|mut node| {
-                if !node.is_leaf() {
-                    node.offset += base;
-                }
-                node
-            }));
-        }
-        Subtree::Split { bounds, children } => {
-            let index = nodes.len();
-            nodes.push(BinaryNode::interior(bounds));
-            let (below, above) = *children;
-            flatten(below, nodes);
-            nodes[index].offset = nodes.len() as u32;
-            flatten(above, nodes);
+            build_serial(Node { prims: below_prims, extent: below, first: node.first, depth }, run, cost);
+            run.slots[index - run.base].offset = (run.base + run.len) as u32;
+            build_serial(Node { prims: above_prims, extent: above, first: node.first + mid, depth }, run, cost);
         }
     }
 }

@@ -33,14 +33,59 @@ fn wide_nodes_have_two_to_eight_children_and_keep_every_leaf() {
     let boxes = point_boxes(&points);
     let (binary, _) = build::build(boxes.len(), |index| boxes[index], LeafCost::PerPrimitive);
     let bvh = Bvh::build(&boxes);
-    let binary_leaves = binary.iter().filter(|node| node.is_leaf()).count();
+    let reached = reachable(&binary);
+    let binary_leaves = reached.iter().filter(|&&index| binary[index].is_leaf()).count();
     assert_eq!(bvh.leaf_count(), binary_leaves);
     for node in &bvh.nodes {
         let used = node.used().count_ones() as usize;
         assert!((2..=WIDTH).contains(&used), "{used} children");
         assert!(node.count.iter().all(|&count| count <= 4));
     }
-    assert!(bvh.node_count() * 2 < binary.len(), "{} wide nodes for {} binary ones", bvh.node_count(), binary.len());
+    assert!(bvh.node_count() * 2 < reached.len(), "{} wide nodes for {} binary ones", bvh.node_count(), reached.len());
+}
+
+/// The binary nodes reachable from the root, depth first.
+fn reachable(binary: &[build::BinaryNode]) -> Vec<usize> {
+    let (mut reached, mut stack) = (Vec::new(), vec![0]);
+    while let Some(index) = stack.pop() {
+        reached.push(index);
+        if !binary[index].is_leaf() {
+            stack.extend([binary[index].offset as usize, index + 1]);
+        }
+    }
+    reached
+}
+
+#[test]
+fn binary_subtrees_fill_their_slots_from_the_start() {
+    // Large enough that the first levels are split among threads.
+    let points: Vec<Vec3> = (0..3 * build::PARALLEL_THRESHOLD)
+        .map(|i| Vec3::new((i * 37 % 1009) as Real, (i * 11 % 131) as Real, (i % 7) as Real))
+        .collect();
+    let boxes = point_boxes(&points);
+    let (binary, order) = build::build(boxes.len(), |index| boxes[index], LeafCost::PerPackOfFour);
+    assert_eq!(binary.len(), 2 * boxes.len() - 1, "a slot for every node the tree could have");
+    let reached = reachable(&binary);
+    let mut covered = vec![false; boxes.len()];
+    for &index in &reached {
+        let node = &binary[index];
+        if node.is_leaf() {
+            let first = node.offset as usize;
+            for slot in &mut covered[first..first + node.prim_count as usize] {
+                assert!(!*slot, "two leaves hold primitive {first}");
+                *slot = true;
+            }
+        } else {
+            let (first, second) = (&binary[index + 1], &binary[node.offset as usize]);
+            assert_eq!(first.bounds.union(second.bounds), node.bounds, "node {index} bounds its children");
+        }
+    }
+    assert!(covered.iter().all(|&c| c), "the leaves hold every primitive");
+    let unreached = binary.len() - reached.len();
+    assert!(unreached > 0 && reached.len() >= boxes.len() / 2, "{} nodes reached", reached.len());
+    let mut sorted = order;
+    sorted.sort_unstable();
+    assert!(sorted.iter().enumerate().all(|(i, &p)| p == i as u32), "the order is a permutation");
 }
 
 #[test]
