@@ -14,47 +14,108 @@ use super::super::huge_page_vec;
 use super::super::real::Real;
 use rayon::prelude::*;
 
+/// Wide nodes this many levels below the root start subtrees laid out each on its own task:
+/// up to 8² = 64 of them, enough to share among threads, few enough to cost nothing to join.
+const PARALLEL_DEPTH: usize = 2;
+/// Trees of fewer binary nodes are laid out on one thread.
+const PARALLEL_NODES: usize = 1 << 15;
+
 /// The wide nodes in depth-first order (a node's first interior child follows it), root first.
 ///
-/// The tree is laid out first as the binary nodes each wide node's children are, and the wide
-/// node each interior binary child became; the wide nodes, with their children's boxes
-/// quantised, are then made node by node in parallel (a node's quantisation depends on its
-/// children's boxes only, so the result is the same on any number of threads). A layout entry
-/// is a few indices rather than the children's boxes: a tenth of the memory to write and read
-/// back, which for large meshes was most of the collapse's time.
+/// The tree is laid out first: for each wide node, the binary nodes its children are and where
+/// the wide nodes of its interior children are, relative to itself. Subtrees below the first
+/// levels are laid out in parallel, each on its own, and relative positions do not change when
+/// they are put side by side, so the layout is the same on any number of threads. The wide
+/// nodes, with their children's boxes quantised, are then made node by node in parallel (a
+/// node's quantisation depends on its children's boxes only). A layout entry is a few indices
+/// rather than the children's boxes: a fraction of the memory to write and read back, which for
+/// large meshes was most of the collapse's time.
 pub(super) fn collapse(binary: &[BinaryNode]) -> Vec<BvhNode> {
-    let mut layout = Vec::with_capacity(binary.len() / 4 + 1);
-    let mut wide = vec![0; binary.len()];
-    if !binary.is_empty() {
-        emit(binary, 0, &mut layout, &mut wide);
+    let parallel_depth = if binary.len() >= PARALLEL_NODES { PARALLEL_DEPTH } else { 0 };
+    collapse_in_parallel_to(binary, parallel_depth)
+}
+
+/// [`collapse`], with subtrees laid out in parallel from `parallel_depth` levels below the root
+/// (0: the whole tree on this thread).
+pub(super) fn collapse_in_parallel_to(binary: &[BinaryNode], parallel_depth: usize) -> Vec<BvhNode> {
+    if binary.is_empty() {
+        return Vec::new();
     }
-    let mut nodes = huge_page_vec(layout.len());
-    nodes.par_extend(layout.par_iter().map(|(slots, len)| {
-        let children = slots.map(|slot| {
-            let node = &binary[slot as usize];
-            let index = if node.is_leaf() { node.offset } else { wide[slot as usize] };
+    let pieces = lay_out(binary, 0, parallel_depth);
+    // Where each piece starts among the wide nodes, and one past the last.
+    let starts: Vec<usize> = pieces
+        .iter()
+        .scan(0, |start, piece| {
+            let this = *start;
+            *start += piece.len();
+            Some(this)
+        })
+        .chain([pieces.iter().map(Vec::len).sum()])
+        .collect();
+    let total = starts[pieces.len()];
+    let mut nodes = huge_page_vec(total);
+    nodes.par_extend((0..total).into_par_iter().map(|wide| {
+        let piece = starts.partition_point(|&start| start <= wide) - 1;
+        let entry = &pieces[piece][wide - starts[piece]];
+        let children = entry.slots.map(|slot| &binary[slot as usize]);
+        let children: [Child; WIDTH] = std::array::from_fn(|k| {
+            let node = children[k];
+            let index = if node.is_leaf() { node.offset } else { wide as u32 + entry.below[k] };
             Child { bounds: node.bounds, index, count: node.prim_count }
         });
-        BvhNode::new(&children[..*len as usize])
+        BvhNode::new(&children[..entry.len as usize])
     }));
     nodes
 }
 
-/// The binary nodes that are a wide node's children, in order, and how many there are.
-type Slots = ([u32; WIDTH], u8);
+/// One wide node as laid out: the binary nodes that are its children, in order, how many there
+/// are, and for each interior child how far after this node its wide node is.
+struct Entry {
+    slots: [u32; WIDTH],
+    below: [u32; WIDTH],
+    len: u8,
+}
+
+/// The wide subtree of binary node `index`, depth first, as pieces to be put side by side: at
+/// `parallel_depth` levels below, one piece a subtree, each laid out on its own task.
+fn lay_out(binary: &[BinaryNode], index: usize, parallel_depth: usize) -> Vec<Vec<Entry>> {
+    if parallel_depth == 0 {
+        let mut piece = Vec::new();
+        lay_out_serial(binary, index, &mut piece);
+        return vec![piece];
+    }
+    let mut entry = entry(binary, index);
+    let interior: Vec<usize> = (0..entry.len as usize).filter(|&k| !binary[entry.slots[k] as usize].is_leaf()).collect();
+    let subtrees: Vec<Vec<Vec<Entry>>> =
+        interior.par_iter().map(|&k| lay_out(binary, entry.slots[k] as usize, parallel_depth - 1)).collect();
+    let mut next = 1;
+    for (&k, subtree) in interior.iter().zip(&subtrees) {
+        entry.below[k] = next;
+        next += subtree.iter().map(Vec::len).sum::<usize>() as u32;
+    }
+    let mut pieces = vec![vec![entry]];
+    pieces.extend(subtrees.into_iter().flatten());
+    pieces
+}
 
 /// Appends the wide node standing for binary node `index` and then, depth first, the wide
-/// nodes of its interior children, recording in `wide` the wide node each interior binary
-/// node became.
-fn emit(binary: &[BinaryNode], index: usize, layout: &mut Vec<Slots>, wide: &mut [u32]) {
-    let (slots, len) = children(binary, index);
-    wide[index] = layout.len() as u32;
-    layout.push((slots.map(|slot| slot as u32), len as u8));
-    for &slot in &slots[..len] {
+/// nodes of its interior children.
+fn lay_out_serial(binary: &[BinaryNode], index: usize, piece: &mut Vec<Entry>) {
+    let own = piece.len();
+    piece.push(entry(binary, index));
+    for k in 0..piece[own].len as usize {
+        let slot = piece[own].slots[k] as usize;
         if !binary[slot].is_leaf() {
-            emit(binary, slot, layout, wide);
+            piece[own].below[k] = (piece.len() - own) as u32;
+            lay_out_serial(binary, slot, piece);
         }
     }
+}
+
+/// The entry for binary node `index`, its children found but not yet placed.
+fn entry(binary: &[BinaryNode], index: usize) -> Entry {
+    let (slots, len) = children(binary, index);
+    Entry { slots: slots.map(|slot| slot as u32), below: [0; WIDTH], len: len as u8 }
 }
 
 /// The binary nodes that become the children of the wide node for `index`, in tree order. A

@@ -44,6 +44,20 @@ fn wide_nodes_have_two_to_eight_children_and_keep_every_leaf() {
     assert!(bvh.node_count() * 2 < reached.len(), "{} wide nodes for {} binary ones", bvh.node_count(), reached.len());
 }
 
+#[test]
+fn subtrees_laid_out_in_parallel_make_the_same_wide_tree() {
+    let points: Vec<Vec3> = (0..20_000)
+        .map(|i| Vec3::new((i * 37 % 1009) as Real, (i * 11 % 131) as Real, (i * 5 % 17) as Real))
+        .collect();
+    let boxes = point_boxes(&points);
+    let (binary, _) = build::build(boxes.len(), |index| boxes[index], LeafCost::PerPackOfFour);
+    let serial = collapse::collapse_in_parallel_to(&binary, 0);
+    assert!(serial.len() > 100, "{} wide nodes", serial.len());
+    for depth in 1..=3 {
+        assert!(collapse::collapse_in_parallel_to(&binary, depth) == serial, "pieces from depth {depth}");
+    }
+}
+
 /// The binary nodes reachable from the root, depth first.
 fn reachable(binary: &[build::BinaryNode]) -> Vec<usize> {
     let (mut reached, mut stack) = (Vec::new(), vec![0]);
