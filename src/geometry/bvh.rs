@@ -14,6 +14,7 @@ mod packet;
 mod traverse;
 
 use std::mem::MaybeUninit;
+use rayon::prelude::*;
 
 use super::Ray;
 use super::aabb::Aabb;
@@ -159,22 +160,27 @@ impl Bvh {
                 }
             }
         }
-        let mut leaves = Vec::new();
-        let mut first = 0;
-        while first < count_at.len() {
-            let count = count_at[first];
-            debug_assert!(count > 0, "leaves cover the primitive order");
-            leaves.push((first as u32, count));
-            first += count.max(1) as usize;
-        }
+        // Only leaves' first primitives have a count, so a filter finds them all at once, where
+        // stepping from each leaf to the next would wait for every count in turn.
+        let leaves: Vec<(u32, u32)> = count_at
+            .par_iter()
+            .enumerate()
+            .filter(|&(_, &count)| count > 0)
+            .map(|(first, &count)| (first as u32, count))
+            .collect();
+        debug_assert!(
+            leaves.iter().try_fold(0, |next, &(first, count)| (first == next).then_some(first + count))
+                == Some(self.prim_indices.len() as u32),
+            "leaves cover the primitive order"
+        );
         leaves
     }
 
     /// Replaces each leaf's `(first, count)` by `remap(first, count)`: how a mesh points its
     /// leaves at the packs of triangles it made of them. Only [`traverse`] with the caller's own
     /// leaf test makes sense afterwards.
-    pub fn remap_leaves(&mut self, mut remap: impl FnMut(u32, u32) -> (u32, u32)) {
-        for node in &mut self.nodes {
+    pub fn remap_leaves(&mut self, remap: impl Fn(u32, u32) -> (u32, u32) + Sync) {
+        self.nodes.par_iter_mut().for_each(|node| {
             for lane in 0..WIDTH {
                 if node.count[lane] > 0 {
                     let (first, count) = remap(node.child[lane], node.count[lane] as u32);
@@ -182,7 +188,7 @@ impl Bvh {
                     (node.child[lane], node.count[lane]) = (first, count as u8);
                 }
             }
-        }
+        });
     }
 
     /// The original primitive indices in leaf order.
