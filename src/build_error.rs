@@ -26,8 +26,8 @@ pub enum BuildError {
 pub enum MeshError {
     #[error("the mesh has no triangles")]
     NoTriangles,
-    #[error("{count} triangles or vertices are more than 32-bit indices can address")]
-    TooLarge { count: usize },
+    #[error("{count} triangles or vertices are more than a mesh can hold (at most {limit})")]
+    TooLarge { count: usize, limit: usize },
     #[error("vertex {vertex} has a non-finite coordinate: {position:?}")]
     NonFinitePosition { vertex: usize, position: [f64; 3] },
     #[error("triangle {triangle} uses vertex {index}, but there are only {vertex_count} vertices")]

@@ -38,6 +38,9 @@ pub const WIDTH: usize = 8;
 /// the nearest, ties to the smaller index, wins whatever the order.
 const BOX_SLACK: Real = 1.0 + 64.0 * MACHINE_EPSILON;
 
+/// Most primitives a BVH holds: the binary tree's `2n − 1` node slots are numbered with `u32`.
+pub const MAX_PRIMITIVES: usize = 1 << 31;
+
 /// Deepest binary tree [`Bvh::build`] can produce: SAH splits are allowed up to
 /// `build::SAH_DEPTH_LIMIT` levels, after which median splits at most halve `u32::MAX` primitives
 /// down to a leaf. The wide tree is no deeper, and each node visited pushes at most `WIDTH − 1`
@@ -109,7 +112,7 @@ impl Bvh {
     /// such input still yields small leaves through median splits.
     ///
     /// # Panics
-    /// If there are more than `u32::MAX` primitives.
+    /// If there are more than [`MAX_PRIMITIVES`].
     pub fn build(bounds: &[Aabb]) -> Bvh {
         Bvh::build_for(bounds, LeafCost::PerPrimitive)
     }

@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use super::aabb::Aabb;
 use super::huge_page_vec;
-use super::bvh::{Bvh, LeafCost, PACKET, PacketLanes, traverse, traverse_interleaved, traverse_packet};
+use super::bvh::{Bvh, LeafCost, MAX_PRIMITIVES, PACKET, PacketLanes, traverse, traverse_interleaved, traverse_packet};
 use super::triangle::{
     PackRay, RayLanes, TriangleHit, TrianglePack, face_normal, normalize,
     triangle_surface,
@@ -314,9 +314,9 @@ fn validate(positions: &[Vec3], triangles: &[[u32; 3]]) -> Result<(), MeshError>
     if triangles.is_empty() {
         return Err(MeshError::NoTriangles);
     }
-    for count in [positions.len(), triangles.len()] {
-        if u32::try_from(count).is_err() {
-            return Err(MeshError::TooLarge { count });
+    for (count, limit) in [(positions.len(), u32::MAX as usize), (triangles.len(), MAX_PRIMITIVES)] {
+        if count > limit {
+            return Err(MeshError::TooLarge { count, limit });
         }
     }
     if let Some(vertex) = positions.iter().position(|p| !p.is_finite()) {

@@ -98,7 +98,7 @@ impl BinaryNode {
 /// (see [`build_parallel`]), the root first; slots no node is stored in are zeroed, and no
 /// node points at them.
 pub(super) fn build(count: usize, bounds_of: impl Fn(usize) -> Aabb + Sync, cost: LeafCost) -> (Vec<BinaryNode>, Vec<u32>) {
-    assert!(u32::try_from(count).is_ok(), "a BVH holds at most u32::MAX primitives");
+    assert!(count <= super::MAX_PRIMITIVES, "a BVH holds at most 2^31 primitives, not {count}");
     if count == 0 {
         return (Vec::new(), Vec::new());
     }
