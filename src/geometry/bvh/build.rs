@@ -277,11 +277,11 @@ struct Run<'a> {
 }
 
 impl Run<'_> {
-    /// Fills the next slot; returns its index in the whole tree.
+    /// Fills the next slot; returns its index among the run's slots.
     fn push(&mut self, node: BinaryNode) -> usize {
         self.slots[self.len] = node;
         self.len += 1;
-        self.base + self.len - 1
+        self.len - 1
     }
 }
 
@@ -296,7 +296,7 @@ fn build_serial(node: Node, run: &mut Run, cost: LeafCost) {
             let (below_prims, above_prims) = node.prims.split_at_mut(mid);
             let depth = node.depth + 1;
             build_serial(Node { prims: below_prims, extent: below, first: node.first, depth }, run, cost);
-            run.slots[index - run.base].offset = (run.base + run.len) as u32;
+            run.slots[index].offset = (run.base + run.len) as u32;
             build_serial(Node { prims: above_prims, extent: above, first: node.first + mid, depth }, run, cost);
         }
     }

@@ -42,17 +42,12 @@ pub(super) fn collapse_in_parallel_to(binary: &[BinaryNode], parallel_depth: usi
         return Vec::new();
     }
     let pieces = lay_out(binary, 0, parallel_depth);
-    // Where each piece starts among the wide nodes, and one past the last.
-    let starts: Vec<usize> = pieces
-        .iter()
-        .scan(0, |start, piece| {
-            let this = *start;
-            *start += piece.len();
-            Some(this)
-        })
-        .chain([pieces.iter().map(Vec::len).sum()])
-        .collect();
-    let total = starts[pieces.len()];
+    // Where each piece starts among the wide nodes.
+    let (mut starts, mut total) = (Vec::with_capacity(pieces.len()), 0);
+    for piece in &pieces {
+        starts.push(total);
+        total += piece.len();
+    }
     let mut nodes = huge_page_vec(total);
     nodes.par_extend((0..total).into_par_iter().map(|wide| {
         let piece = starts.partition_point(|&start| start <= wide) - 1;

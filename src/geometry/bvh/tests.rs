@@ -71,7 +71,7 @@ fn reachable(binary: &[build::BinaryNode]) -> Vec<usize> {
 }
 
 #[test]
-fn binary_subtrees_fill_their_slots_from_the_start() {
+fn slotted_binary_tree_holds_every_primitive_once_and_bounds_its_children() {
     // Large enough that the first levels are split among threads.
     let points: Vec<Vec3> = (0..3 * build::PARALLEL_THRESHOLD)
         .map(|i| Vec3::new((i * 37 % 1009) as Real, (i * 11 % 131) as Real, (i % 7) as Real))
