@@ -33,7 +33,7 @@ fn provenance_cost(c: &mut Criterion) {
     group.bench_function("hash/blob_1m", |b| b.iter(|| provenance(&case).expect("hashes")));
 
     let exr = encode_exr(&Film::new(512, 512)).expect("encodes");
-    let made = provenance(&case).expect("hashes").with_run(1.25, 2);
+    let made = provenance(&case).expect("hashes").with_run(1.25, 2, Some("bench"));
     let stamped = made.stamp(&exr, "bench").expect("stamps");
     group.throughput(Throughput::Bytes(exr.len() as u64));
     group.bench_function("stamp/exr_512", |b| {

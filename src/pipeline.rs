@@ -13,7 +13,7 @@ use crate::film::{Film, OutputOptions, write_outputs};
 use crate::options::{Profile, RenderOptions, Seeding, Spawn};
 use crate::progress::{Progress, Silent};
 use crate::provenance::{ContentHash, Provenance, ProvenanceError, keys};
-use crate::stats::{BuildStats, Phases, RayCounts, RenderStats};
+use crate::stats::{BuildStats, Phases, RayCounts, RenderStats, this_host};
 use crate::with_precision;
 
 mod faults;
@@ -24,6 +24,16 @@ pub use faults::{FaultRenderer, case_with_faults, fault_applies, orthonormal_up,
 pub struct Rendered {
     pub written: Vec<PathBuf>,
     pub stats: RenderStats,
+}
+
+/// Whether the run's own record (render time, thread count, host: [`Provenance::with_run`]) is
+/// written into the outputs. Without it, the same case and binary give byte-identical files; the
+/// record is in the statistics either way.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum RunRecord {
+    #[default]
+    Omitted,
+    InOutputs,
 }
 
 /// Renders a loaded case to a film, in the precision it asks for.
@@ -105,7 +115,7 @@ pub fn output_options(case: &Case) -> OutputOptions {
 /// How a render of `case` is made, for its outputs to carry: this build, the case file's name,
 /// the BLAKE3 hash of the case file and of every asset it reads ([`Case::assets`], in that
 /// order, each framed by its length), and the render settings. This is the stable group only:
-/// commands add the run's time and thread count ([`Provenance::with_run`]).
+/// commands add the run's record when asked ([`RunRecord`]).
 pub fn provenance(case: &Case) -> Result<Provenance, Error> {
     let mut hash = ContentHash::default();
     for path in std::iter::once(case.path.clone()).chain(case.assets()) {
@@ -135,12 +145,14 @@ pub fn render_case_file(
     path: &Path,
     out_dir: &Path,
     load: &LoadOptions,
+    record: RunRecord,
     progress: &dyn Progress,
 ) -> Result<Rendered, Error> {
     measured_run(
         || Ok(case::load(path, load)?),
         progress,
         true,
+        record,
         |case, film, provenance| {
             Ok(write_outputs(
                 out_dir,
@@ -159,24 +171,27 @@ pub fn render_assignment(
     scene: &Path,
     options: &AssignmentOptions,
     outputs: &AssignmentOutputs,
+    record: RunRecord,
     progress: &dyn Progress,
 ) -> Result<Rendered, Error> {
     measured_run(
         || Ok(load_assignment_scene(scene, options)?),
         progress,
         outputs.writes_aovs(),
+        record,
         |_, film, provenance| Ok(outputs.write(film, provenance)?),
     )
 }
 
-/// Load, build, render (with the AOVs when `aovs`) and write with the case's provenance and this
-/// run's (render time, thread count), timing each phase and counting rays. The commands always measure: counting costs nothing measurable (`cargo bench --
-/// stats_overhead`), so `--stats` only decides whether the numbers are shown, and can never
-/// change what is rendered.
+/// Load, build, render (with the AOVs when `aovs`) and write with the case's provenance (and the
+/// run's record when `record` asks), timing each phase and counting rays. The commands always
+/// measure: counting costs nothing measurable (`cargo bench -- stats_overhead`), so `--stats`
+/// only decides whether the numbers are shown, and can never change what is rendered.
 fn measured_run(
     load: impl FnOnce() -> Result<Case, Error>,
     progress: &dyn Progress,
     aovs: bool,
+    record: RunRecord,
     write: impl FnOnce(&Case, &Film, &Provenance) -> Result<Vec<PathBuf>, Error>,
 ) -> Result<Rendered, Error> {
     let start = Instant::now();
@@ -192,7 +207,12 @@ fn measured_run(
     });
     let measured = measured?;
     let threads = rayon::current_num_threads();
-    let provenance = provenance?.with_run(measured.render_time.as_secs_f64(), threads);
+    let provenance = match record {
+        RunRecord::Omitted => provenance?,
+        RunRecord::InOutputs => {
+            provenance?.with_run(measured.render_time.as_secs_f64(), threads, this_host().as_deref())
+        }
+    };
     let write_start = Instant::now();
     let written = write(&case, &measured.film, &provenance)?;
     let phases = Phases {

@@ -11,7 +11,7 @@ use std::process::{Command, Output};
 use goldray::case::{AssignmentOptions, load_assignment_scene};
 use goldray::film::{Tonemap, color_image, depth_image, normals_image};
 use goldray::pipeline::render_case;
-use goldray::provenance::{Group, Provenance, RUN_PREFIX, keys, strip};
+use goldray::provenance::{Group, Provenance, keys, strip};
 use image::RgbImage;
 
 /// The course's scene `file` (e.g. `scene01_plane.txt`).
@@ -177,15 +177,15 @@ fn drop_in_command_and_imported_case_give_identical_files() {
         ] {
             let a = fs::read(dir.path().join(course_file)).unwrap();
             let b = fs::read(dir.path().join("out").join(case_file)).unwrap();
-            // The files name their own source (the scene file, the TOML) and its hash, and the
-            // run's time: everything else, every pixel byte and every setting, is the same.
+            // The files name their own source (the scene file, the TOML) and its hash: everything
+            // else, every pixel byte and every setting, is the same.
             let made = |bytes: &[u8]| Provenance::from_bytes(bytes, course_file).unwrap().expect("stamped");
             let (course_made, case_made) = (made(&a), made(&b));
             assert_eq!(course_made.get(keys::CASE), Some(format!("{scene}.txt").as_str()));
             assert_eq!(case_made.get(keys::CASE), Some("imported.toml"));
             let settings = |p: &Provenance| -> Vec<(String, String)> {
                 p.entries()
-                    .filter(|(k, _)| ![keys::CASE, keys::CASE_HASH].contains(k) && !k.starts_with(RUN_PREFIX))
+                    .filter(|(k, _)| ![keys::CASE, keys::CASE_HASH].contains(k))
                     .map(|(k, v)| (k.to_owned(), v.to_owned()))
                     .collect()
             };

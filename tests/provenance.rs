@@ -100,7 +100,6 @@ fn a_rendered_exr_and_png_carry_every_field() {
         (keys::PRECISION, "f32"),
         (keys::PROFILE, "native"),
         (keys::TONEMAP, "srgb"),
-        (keys::RUN_THREADS, "1"),
     ]
     .into_iter()
     .map(|(k, v)| (k.to_owned(), v.to_owned()))
@@ -109,16 +108,37 @@ fn a_rendered_exr_and_png_carry_every_field() {
     if let Some(commit) = build_commit(env!("GOLDRAY_GIT_COMMIT")) {
         expected.insert(keys::COMMIT.to_owned(), commit.to_owned());
     }
+    // By default the files hold the stable group only: no time, threads or host.
     for (file, found) in [
         ("tiny.exr", exr_attributes(&out.join("tiny.exr"))),
         ("tiny.png", png_text(&out.join("tiny.png"))),
+    ] {
+        assert_eq!(found, expected, "{file}");
+    }
+    // `--record-run` adds the run group, and nothing else: without it the file is the default
+    // file, byte for byte.
+    let recorded = dir.path().join("recorded");
+    render_on_threads(&case, &recorded, "1", &["--record-run"]);
+    for (file, found) in [
+        ("tiny.exr", exr_attributes(&recorded.join("tiny.exr"))),
+        ("tiny.png", png_text(&recorded.join("tiny.png"))),
     ] {
         let mut found = found;
         let seconds = found
             .remove(keys::RUN_SECONDS)
             .unwrap_or_else(|| panic!("{file}: no render time"));
         assert!(seconds.parse::<f64>().is_ok_and(|s| s >= 0.0), "{file}: {seconds}");
+        assert_eq!(found.remove(keys::RUN_THREADS).as_deref(), Some("1"), "{file}");
+        assert_eq!(found.remove(keys::RUN_HOST), goldray::stats::this_host(), "{file}");
         assert_eq!(found, expected, "{file}");
+        let (plain, with_run) = (
+            fs::read(out.join(file)).unwrap(),
+            fs::read(recorded.join(file)).unwrap(),
+        );
+        assert!(
+            strip(&with_run, Group::Run).unwrap() == plain,
+            "{file}: the run group is not all that differs"
+        );
     }
 
     // The hash covers the mesh: changing only the mesh changes it.
@@ -263,7 +283,9 @@ fn stamping_replaces_and_stripping_restores_the_encoded_bytes() {
     let film = goldray::film::Film::new(5, 40);
     let exr = goldray::film::encode_exr(&film).unwrap();
     let png = goldray::film::encode_png(&goldray::film::color_image(&film, goldray::film::Tonemap::Srgb)).unwrap();
-    let made = Provenance::this_build().with(keys::CASE, "naïve.toml").with_run(1.5, 3);
+    let made = Provenance::this_build()
+        .with(keys::CASE, "naïve.toml")
+        .with_run(1.5, 3, Some("host"));
     for (name, bytes) in [("exr", &exr), ("png", &png)] {
         let stamped = made.stamp(bytes, name).unwrap();
         assert_eq!(

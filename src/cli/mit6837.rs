@@ -15,7 +15,7 @@ use super::render::RunFlags;
 /// The usage line as the course spells it.
 pub const USAGE: &str = "goldray mit6837 -input scene.txt -output out.png [-normals n.png] [-size w h] \
                          [-depth min max d.png] [-bounces n] [-shadows] [-jitter] [-filter] [--exr out.exr] \
-                         [--threads N] [--quiet] [--force] [--stats] [--stats-json FILE]";
+                         [--threads N] [--quiet] [--force] [--stats] [--stats-json FILE] [--record-run]";
 
 /// The flags the course binary itself takes, which help shows with one dash, as the course does.
 const COURSE_FLAGS: [&str; 9] = [
@@ -156,7 +156,7 @@ pub fn run(args: Mit6837Args) -> Result<ExitCode, Failure> {
     for path in paths {
         check_writable_file(path).map_err(Failure::Run)?;
     }
-    let rendered = run.render(|reporter| render_assignment(&input, &options, &outputs, reporter))?;
+    let rendered = run.render(|reporter| render_assignment(&input, &options, &outputs, run.record(), reporter))?;
     run.report(&rendered)
 }
 

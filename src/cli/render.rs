@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use goldray::case::LoadOptions;
-use goldray::pipeline::{Rendered, render_case_file};
+use goldray::pipeline::{Rendered, RunRecord, render_case_file};
 
 use super::Failure;
 use super::common::{ThreadFlags, check_writable_file};
@@ -39,6 +39,10 @@ pub struct RunFlags {
     /// Write the same statistics as JSON to FILE.
     #[arg(long, value_name = "FILE")]
     stats_json: Option<PathBuf>,
+    /// Also write this run's record (render time, thread count, host) into every output, as
+    /// `goldray.run.*`. Without it, the same case and binary give byte-identical files.
+    #[arg(long)]
+    record_run: bool,
 }
 
 pub fn run(args: RenderArgs) -> Result<ExitCode, Failure> {
@@ -48,7 +52,7 @@ pub fn run(args: RenderArgs) -> Result<ExitCode, Failure> {
         allow_huge_images: run.force,
     };
     let rendered = run
-        .render(|reporter| render_case_file(&case, &out, &load, reporter))
+        .render(|reporter| render_case_file(&case, &out, &load, run.record(), reporter))
         .map_err(|failure| match failure {
             Failure::Run(_) if looks_like_course_scene(&case) => Failure::Run(format!(
                 "{0} is a course scene file, not a TOML case: render it with `goldray mit6837 -input {0} \
@@ -61,6 +65,15 @@ pub fn run(args: RenderArgs) -> Result<ExitCode, Failure> {
 }
 
 impl RunFlags {
+    /// Whether the outputs carry the run's record.
+    pub fn record(&self) -> RunRecord {
+        if self.record_run {
+            RunRecord::InOutputs
+        } else {
+            RunRecord::Omitted
+        }
+    }
+
     /// Checks the statistics file can be written, then renders on the asked pool with a
     /// progress reporter.
     pub fn render(

@@ -168,8 +168,8 @@ mod tests {
 
     #[test]
     fn the_same_making_or_only_a_different_run_says_nothing() {
-        let a = made(7, 16).with_run(0.5, 1);
-        let b = made(7, 16).with_run(2.25, 2);
+        let a = made(7, 16).with_run(0.5, 1, Some("a"));
+        let b = made(7, 16).with_run(2.25, 2, Some("b"));
         assert_eq!(line(Some(&a), Some(&b)), None);
         assert_eq!(line(None, None), None);
     }

@@ -4,12 +4,12 @@
 //! hash of it and its assets) and which render settings made it.
 //!
 //! The record is two groups. The **stable** group is a function of the case and the binary, like
-//! the pixels. The **run** group (`goldray.run.*`: render time and thread count) differs from one
-//! run to the next, so it would break "same case + same binary = bit-identical EXR" if the
-//! determinism tests compared it: they compare files with [`strip`]`(bytes, Group::Run)`, which
-//! removes exactly those attributes and leaves every other byte as written. Outputs that are
-//! themselves compared by content (the golden suite's snapshots, the grading cache) carry only
-//! the stable group.
+//! the pixels, and is always written: the same case and binary give byte-identical files, so
+//! `cmp`, `sha256sum` and content-addressed caches can tell whether anything changed. The **run**
+//! group (`goldray.run.*`: render time, thread count, host) differs from one run to the next, so
+//! it is written only when asked (`--record-run`); the commands report it through `--stats`
+//! either way. [`strip`]`(bytes, Group::Run)` turns a file written with it into the file written
+//! without it, byte for byte.
 //!
 //! Both groups are spliced into already encoded bytes (`exr_header`, `png_text`) rather than
 //! handed to the encoders: the exr crate writes custom attributes from a `HashMap`, in an order
@@ -54,6 +54,8 @@ pub mod keys {
     /// Seconds spent rendering (building the scene and writing excluded).
     pub const RUN_SECONDS: &str = "goldray.run.seconds";
     pub const RUN_THREADS: &str = "goldray.run.threads";
+    /// The name of the machine that rendered it.
+    pub const RUN_HOST: &str = "goldray.run.host";
 }
 
 /// One output's provenance: `goldray.*` names and their text values, kept sorted so that a file
@@ -120,10 +122,16 @@ impl Provenance {
         self
     }
 
-    /// The render time and thread count of this run (the run group).
-    pub fn with_run(self, render_seconds: f64, threads: usize) -> Provenance {
-        self.with(keys::RUN_SECONDS, format_args!("{render_seconds:.3}"))
-            .with(keys::RUN_THREADS, threads)
+    /// The render time, thread count and host of this run (the run group); an unknown host is
+    /// left out.
+    pub fn with_run(self, render_seconds: f64, threads: usize, host: Option<&str>) -> Provenance {
+        let provenance = self
+            .with(keys::RUN_SECONDS, format_args!("{render_seconds:.3}"))
+            .with(keys::RUN_THREADS, threads);
+        match host {
+            Some(host) => provenance.with(keys::RUN_HOST, host),
+            None => provenance,
+        }
     }
 
     pub fn get(&self, key: &str) -> Option<&str> {
@@ -267,6 +275,7 @@ mod tests {
             keys::TONEMAP,
             keys::RUN_SECONDS,
             keys::RUN_THREADS,
+            keys::RUN_HOST,
         ] {
             assert!(key.starts_with(PREFIX) && key.len() <= 31, "{key}");
         }

@@ -122,6 +122,8 @@ pub struct RenderStats {
     pub height: u32,
     /// Worker threads the render ran on.
     pub threads: usize,
+    /// The machine it ran on (its node name), where the system tells.
+    pub host: Option<String>,
     pub seconds: Phases,
     #[serde(flatten)]
     pub build: BuildStats,
@@ -149,6 +151,7 @@ impl RenderStats {
             width,
             height,
             threads,
+            host: this_host(),
             seconds: phases,
             build,
             rays: PerKind::of(rays, |count| count),
@@ -172,6 +175,12 @@ impl RenderStats {
             source,
         })
     }
+}
+
+/// This machine's name (`uname`'s node name), or `None` where it has none.
+pub fn this_host() -> Option<String> {
+    let name = rustix::system::uname().nodename().to_string_lossy().into_owned();
+    (!name.is_empty()).then_some(name)
 }
 
 /// The process's peak resident set size so far, from Linux's `/proc/self/status` (`VmHWM`);

@@ -17,9 +17,14 @@ impl Display for RenderStats {
         } else {
             format!("{} threads", self.threads)
         };
+        let host = self
+            .host
+            .as_deref()
+            .map(|host| format!(" on {host}"))
+            .unwrap_or_default();
         writeln!(
             f,
-            "Statistics for {} ({}×{}, {threads})",
+            "Statistics for {} ({}×{}, {threads}{host})",
             self.case, self.width, self.height
         )?;
         let times = &self.seconds;
