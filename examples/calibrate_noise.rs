@@ -1,4 +1,4 @@
-//! Calibrates the statistical verdict (README, "Golden images"): renders every sampled case of
+//! Calibrates the statistical verdict (docs/statistical-verdict.md): renders every sampled case of
 //! `cases/` with other seeds and judges each render against its golden image, as the golden
 //! suite does, to measure the false-alarm rate; then renders each planted bug (tests/noise/
 //! planted.rs) with other seeds to measure the detection rate, and prints the power the verdict

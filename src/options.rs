@@ -30,7 +30,7 @@ named_enum! {
 named_enum! {
     /// The floating-point type of all geometry and shading. The film is `f32` either way, because
     /// that is what the EXR holds; `F64` buys accuracy far from the origin or across extreme scales
-    /// with speed (see README, "Numerical stability").
+    /// with speed (see docs/extremes.md).
     #[derive(Default)]
     pub enum Precision: "precision" {
         #[default]

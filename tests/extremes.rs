@@ -1,5 +1,5 @@
 //! Inputs at the edges of the model: each gives a finite, sensible picture or a clear error.
-//! README's "Extremes" table documents the same decisions.
+//! The table of docs/extremes.md documents the same decisions.
 
 use std::path::Path;
 

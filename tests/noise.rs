@@ -4,7 +4,7 @@
 //! The re-seeding and planted-bug tests render the sampled cases of `cases/` at full size and
 //! judge them against the committed goldens, exactly as the golden suite does. The 50-seed
 //! false-alarm test renders the same cases at 48×48 against a golden rendered here at that size,
-//! to keep it quick; `examples/calibrate_noise.rs` measures the same at full size (README).
+//! to keep it quick; `examples/calibrate_noise.rs` measures the same at full size (docs/statistical-verdict.md).
 
 #[path = "noise/planted.rs"]
 mod planted;

@@ -1,5 +1,5 @@
-//! Differential test of `goldray mit6837` against the course's reference renderer (README,
-//! "Differential testing against the course binary").
+//! Differential test of `goldray mit6837` against the course's reference renderer
+//! (docs/differential-testing.md).
 //!
 //! Each seed names one random valid scene (`generate.rs`). Both binaries render it twice, as
 //! the course grades: plain, and with `-shadows -bounces N`; each run writes the colour, normals

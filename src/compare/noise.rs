@@ -54,7 +54,7 @@ pub const RELATIVE_FLOOR: f64 = 1.0 / 65536.0;
 
 /// How far each colour value of a student's 8-bit picture may stray from the golden picture
 /// because of sampling noise, in 8-bit codes: what a rubric's `statistical = true` adds to its
-/// `threshold` (see README, "The rubric").
+/// `threshold` (see docs/grading.md, "The rubric").
 ///
 /// A student's jittered picture has no variance channel, so its noise is estimated from the
 /// golden's: the student's mean is assumed as noisy as the golden's (the same sample count),

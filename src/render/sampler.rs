@@ -54,7 +54,7 @@ pub struct PixelSamples {
 impl PixelSamples {
     /// Position of sample `index` inside the pixel, in `[0, 1)²`: a uniformly jittered point in
     /// stratum `(index mod n, index div n)`. Always inlined: called once per sample, it costs
-    /// a sampled render 19% when the compiler leaves it out of line (README, "Sampled cases").
+    /// a sampled render 19% when the compiler leaves it out of line (docs/statistical-verdict.md).
     #[inline(always)]
     pub fn offset(&self, index: u32) -> Vec2 {
         let strata = self.sampler.strata;

@@ -341,7 +341,7 @@ fn nesting_is_bounded_instead_of_overflowing_the_stack() {
 }
 
 /// Where the course binary asserts, crashes or reads nonsense, goldray says why at the spot. Each
-/// of these was run through the course binary; what it did is in README, "The course's grammar".
+/// of these was run through the course binary; what it did is in docs/course-grammar.md.
 #[test]
 fn what_crashes_the_course_is_a_located_error() {
     let no_material = "Materials { numMaterials 1 Material { } }\nGroup { numObjects 2\n";

@@ -1,4 +1,4 @@
-//! The scheduler examples of README's grading section run as written: the Slurm script under a
+//! The scheduler examples of docs/grading.md run as written: the Slurm script under a
 //! stand-in `sbatch` that runs the array's tasks and then the dependent merge, and the scripts of
 //! the Kubernetes manifest's containers with the environment Kubernetes gives them. Both grade the
 //! small class and must produce the grades of one plain run.
