@@ -16,12 +16,14 @@ impl Isa for Portable {
 
     #[inline(always)]
     fn widen(x: Array<f32, 4>) -> Array<f64, 4> {
-        Array(x.0.map(f64::from))
+        let [a, b, c, d] = x.0;
+        Array([a.into(), b.into(), c.into(), d.into()])
     }
 
     #[inline(always)]
     fn narrow(x: Array<f64, 4>) -> Array<f32, 4> {
-        Array(x.0.map(|v| v as f32))
+        let [a, b, c, d] = x.0;
+        Array([a as f32, b as f32, c as f32, d as f32])
     }
 
     #[inline(always)]
@@ -67,29 +69,33 @@ impl MaskOps for Bits {
     }
 }
 
+/// Each lane operation written out lane by lane (`[f(a[0], b[0]), f(a[1], b[1]), …]`) rather than
+/// as a loop or `array::map`: a kernel inlines thousands of them, and LLVM had to rotate, unroll
+/// and scalarise every loop again (the eight-lane integrator's portable copy alone took most of
+/// the crate's release build). The operations and their order are the same either way.
 macro_rules! array_lanes {
-    ($t:ty) => {
-        impl<const N: usize> Array<$t, N> {
+    ($t:ty, $n:literal, [$($lane:literal),*]) => {
+        impl Array<$t, $n> {
             #[inline(always)]
             fn zip(self, other: Self, f: impl Fn($t, $t) -> $t) -> Self {
-                let mut out = self.0;
-                for lane in 0..N {
-                    out[lane] = f(self.0[lane], other.0[lane]);
-                }
-                Array(out)
+                let (a, b) = (self.0, other.0);
+                Array([$(f(a[$lane], b[$lane])),*])
+            }
+
+            #[inline(always)]
+            fn each(self, f: impl Fn($t) -> $t) -> Self {
+                let a = self.0;
+                Array([$(f(a[$lane])),*])
             }
 
             #[inline(always)]
             fn compare(self, other: Self, f: impl Fn($t, $t) -> bool) -> Bits {
-                let mut bits = 0;
-                for lane in 0..N {
-                    bits |= (f(self.0[lane], other.0[lane]) as u32) << lane;
-                }
-                Bits(bits)
+                let (a, b) = (self.0, other.0);
+                Bits(0 $(| ((f(a[$lane], b[$lane]) as u32) << $lane))*)
             }
         }
 
-        impl<const N: usize> Add for Array<$t, N> {
+        impl Add for Array<$t, $n> {
             type Output = Self;
             #[inline(always)]
             fn add(self, other: Self) -> Self {
@@ -97,7 +103,7 @@ macro_rules! array_lanes {
             }
         }
 
-        impl<const N: usize> Sub for Array<$t, N> {
+        impl Sub for Array<$t, $n> {
             type Output = Self;
             #[inline(always)]
             fn sub(self, other: Self) -> Self {
@@ -105,7 +111,7 @@ macro_rules! array_lanes {
             }
         }
 
-        impl<const N: usize> Mul for Array<$t, N> {
+        impl Mul for Array<$t, $n> {
             type Output = Self;
             #[inline(always)]
             fn mul(self, other: Self) -> Self {
@@ -113,7 +119,7 @@ macro_rules! array_lanes {
             }
         }
 
-        impl<const N: usize> Div for Array<$t, N> {
+        impl Div for Array<$t, $n> {
             type Output = Self;
             #[inline(always)]
             fn div(self, other: Self) -> Self {
@@ -121,38 +127,39 @@ macro_rules! array_lanes {
             }
         }
 
-        impl<const N: usize> Neg for Array<$t, N> {
+        impl Neg for Array<$t, $n> {
             type Output = Self;
             #[inline(always)]
             fn neg(self) -> Self {
-                Array(self.0.map(|a| -a))
+                self.each(|a| -a)
             }
         }
 
-        impl<const N: usize> Lanes for Array<$t, N> {
+        impl Lanes for Array<$t, $n> {
             type Elem = $t;
             type Mask = Bits;
-            const N: usize = N;
+            const N: usize = $n;
 
             #[inline(always)]
             fn splat(value: $t) -> Self {
-                Array([value; N])
+                Array([value; $n])
             }
             #[inline(always)]
             fn load(values: &[$t]) -> Self {
-                Array(values[..N].try_into().expect("N values"))
+                let values = &values[..$n];
+                Array([$(values[$lane]),*])
             }
             #[inline(always)]
             fn store(self, out: &mut [$t]) {
-                out[..N].copy_from_slice(&self.0);
+                out[..$n].copy_from_slice(&self.0);
             }
             #[inline(always)]
             fn sqrt(self) -> Self {
-                Array(self.0.map(<$t>::sqrt))
+                self.each(<$t>::sqrt)
             }
             #[inline(always)]
             fn abs(self) -> Self {
-                Array(self.0.map(<$t>::abs))
+                self.each(<$t>::abs)
             }
             #[inline(always)]
             fn max(self, other: Self) -> Self {
@@ -184,17 +191,14 @@ macro_rules! array_lanes {
             }
             #[inline(always)]
             fn select(mask: Bits, if_true: Self, if_false: Self) -> Self {
-                let mut out = if_false.0;
-                for lane in 0..N {
-                    if mask.0 & (1 << lane) != 0 {
-                        out[lane] = if_true.0[lane];
-                    }
-                }
-                Array(out)
+                let (t, f) = (if_true.0, if_false.0);
+                Array([$(if mask.0 & (1 << $lane) != 0 { t[$lane] } else { f[$lane] }),*])
             }
         }
     };
 }
 
-array_lanes!(f32);
-array_lanes!(f64);
+array_lanes!(f32, 4, [0, 1, 2, 3]);
+array_lanes!(f32, 8, [0, 1, 2, 3, 4, 5, 6, 7]);
+array_lanes!(f64, 4, [0, 1, 2, 3]);
+array_lanes!(f64, 8, [0, 1, 2, 3, 4, 5, 6, 7]);
