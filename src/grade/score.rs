@@ -4,6 +4,8 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use fast_image_resize::images::{TypedImage, TypedImageRef};
+use fast_image_resize::pixels::U8x3;
 use fast_image_resize::{FilterType, ResizeAlg, ResizeOptions, Resizer};
 use serde::{Deserialize, Serialize};
 
@@ -277,12 +279,23 @@ fn thumbnail(picture: &image::RgbImage) -> image::RgbImage {
     }
     let scale = |side: u32| ((u64::from(side) * u64::from(THUMBNAIL)) / u64::from(longest)).max(1) as u32;
     let mut small = image::RgbImage::new(scale(width), scale(height));
+    let (small_width, small_height) = small.dimensions();
     let area_average = ResizeOptions::new().resize_alg(ResizeAlg::Convolution(FilterType::Box));
-    match Resizer::new().resize(picture, &mut small, &area_average) {
+    // Typed as 8-bit RGB: the untyped `Resizer::resize` would compile the resizer for every pixel
+    // type it knows (a third of this crate's code before optimisation) to use one.
+    let resized = TypedImageRef::<U8x3>::from_buffer(width, height, picture.as_raw())
+        .map_err(|_| ())
+        .and_then(|source| {
+            let mut target = TypedImage::<U8x3>::from_buffer(small_width, small_height, &mut small).map_err(|_| ())?;
+            Resizer::new()
+                .resize_typed(&source, &mut target, &area_average)
+                .map_err(|_| ())
+        });
+    match resized {
         Ok(()) => small,
-        // Both are 8-bit RGB pictures, which the resizer takes; should it refuse one anyway, the
-        // report still gets a thumbnail.
-        Err(_) => image::imageops::thumbnail(picture, small.width(), small.height()),
+        // Both are 8-bit RGB buffers of their sizes, which the resizer takes; should it refuse
+        // one anyway, the report still gets a thumbnail.
+        Err(()) => image::imageops::thumbnail(picture, small_width, small_height),
     }
 }
 
