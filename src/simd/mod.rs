@@ -4,7 +4,9 @@
 //! instruction set [`Isa`], against the lane types it provides ([`Lanes`]: 4 or 8 `f32` or `f64`
 //! side by side). Each kernel is compiled once per path: [`SimdPath::Portable`] (plain arrays,
 //! any processor), [`SimdPath::Avx2`] and [`SimdPath::Avx512`] (x86-64 intrinsics, each kernel
-//! compiled with those instructions enabled). [`dispatch`] runs a kernel on the path chosen at
+//! compiled with those instructions enabled; AVX-512 only in a build with the `avx512` feature,
+//! since it renders no faster than AVX2 and every path is a full copy of the kernels to
+//! compile). [`dispatch`] runs a kernel on the path chosen at
 //! run time: AVX2 where the processor has it ([`preferred`]: measured faster than AVX-512), else
 //! the widest it supports, unless the environment variable `GOLDRAY_SIMD` (`portable`, `avx2`,
 //! `avx512`) or [`set_path`] chooses another.
@@ -24,7 +26,9 @@ mod x86;
 
 pub use portable::Portable;
 #[cfg(target_arch = "x86_64")]
-pub use x86::{Avx2, Avx512};
+pub use x86::Avx2;
+#[cfg(all(target_arch = "x86_64", feature = "avx512"))]
+pub use x86::Avx512;
 
 /// An instruction set the kernels can be compiled for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -33,7 +37,8 @@ pub enum SimdPath {
     Portable,
     /// x86-64 with AVX2 and FMA (Haswell, 2013, and later).
     Avx2,
-    /// x86-64 with AVX-512 F, VL, BW and DQ (Skylake-SP, Ice Lake, Zen 4 and later).
+    /// x86-64 with AVX-512 F, VL, BW and DQ (Skylake-SP, Ice Lake, Zen 4 and later), in a build
+    /// with the `avx512` feature.
     Avx512,
 }
 
@@ -48,15 +53,15 @@ impl SimdPath {
         }
     }
 
-    /// Whether this processor can run the path.
+    /// Whether this build has the path and this processor can run it.
     pub fn is_supported(self) -> bool {
         match self {
             SimdPath::Portable => true,
             #[cfg(target_arch = "x86_64")]
             SimdPath::Avx2 => x86::has_avx2(),
-            #[cfg(target_arch = "x86_64")]
+            #[cfg(all(target_arch = "x86_64", feature = "avx512"))]
             SimdPath::Avx512 => x86::has_avx512(),
-            #[cfg(not(target_arch = "x86_64"))]
+            #[allow(unreachable_patterns)]
             _ => false,
         }
     }
@@ -95,8 +100,8 @@ pub fn detected() -> SimdPath {
 /// also has AVX-512. The kernels work on eight lanes, which one AVX2 register holds, and on the
 /// one AVX-512 machine measured (a Sapphire Rapids class Xeon) the AVX2 path was the faster:
 /// camera rays through the 1M-triangle mesh 11.8-12.1 against 10.9-11.0 Mrays/s, random rays on
-/// a par, the Whitted spheres 89-98 against 102-105 ms. AVX-512 stays a choice
-/// (`GOLDRAY_SIMD=avx512`); it computes the same pictures.
+/// a par, the Whitted spheres 89-98 against 102-105 ms. AVX-512 stays a choice in a build with
+/// the `avx512` feature (`GOLDRAY_SIMD=avx512`); it computes the same pictures.
 pub fn preferred() -> SimdPath {
     if SimdPath::Avx2.is_supported() {
         SimdPath::Avx2
@@ -141,9 +146,9 @@ pub fn set_path(path: SimdPath) -> Result<(), UnsupportedPath> {
     Ok(())
 }
 
-/// [`set_path`] was asked for a path this processor cannot run.
+/// [`set_path`] was asked for a path this processor cannot run, or this build does not have.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("this processor cannot run the {} SIMD path", .0.name())]
+#[error("the {} SIMD path is not available: this processor cannot run it or this build leaves it out", .0.name())]
 pub struct UnsupportedPath(pub SimdPath);
 
 /// A kernel: code generic over the instruction set, run by [`dispatch`]. `run` must be
@@ -173,11 +178,11 @@ pub fn dispatch_on<K: Kernel>(path: SimdPath, kernel: K) -> Result<K::Output, Un
 #[inline(always)]
 fn run_on<K: Kernel>(path: SimdPath, kernel: K) -> K::Output {
     match path {
-        #[cfg(target_arch = "x86_64")]
+        #[cfg(all(target_arch = "x86_64", feature = "avx512"))]
         // SAFETY: both callers pass only paths the processor supports.
         SimdPath::Avx512 => unsafe { x86::run_avx512(kernel) },
         #[cfg(target_arch = "x86_64")]
-        // SAFETY: as above.
+        // SAFETY: both callers pass only paths the processor supports.
         SimdPath::Avx2 => unsafe { x86::run_avx2(kernel) },
         _ => kernel.run::<Portable>(),
     }
@@ -283,6 +288,7 @@ mod tests {
             // SAFETY: each trampoline runs only where the processor supports it.
             let results = [
                 x86::has_avx2().then(|| unsafe { x86::run_avx2(Probe) }),
+                #[cfg(feature = "avx512")]
                 x86::has_avx512().then(|| unsafe { x86::run_avx512(Probe) }),
             ];
             for result in results.into_iter().flatten() {

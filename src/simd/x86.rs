@@ -20,6 +20,7 @@ pub(super) fn has_avx2() -> bool {
         && is_x86_feature_detected!("popcnt")
 }
 
+#[cfg(feature = "avx512")]
 pub(super) fn has_avx512() -> bool {
     has_avx2()
         && is_x86_feature_detected!("avx512f")
@@ -38,6 +39,7 @@ pub(super) unsafe fn run_avx2<K: Kernel>(kernel: K) -> K::Output {
 
 /// # Safety
 /// The processor must support AVX-512 ([`has_avx512`]).
+#[cfg(feature = "avx512")]
 #[target_feature(enable = "avx512f,avx512vl,avx512bw,avx512dq,avx512cd,avx2,fma,bmi1,bmi2,lzcnt,popcnt")]
 pub(super) unsafe fn run_avx512<K: Kernel>(kernel: K) -> K::Output {
     kernel.run::<Avx512>()
@@ -48,6 +50,7 @@ pub(super) unsafe fn run_avx512<K: Kernel>(kernel: K) -> K::Output {
 pub struct Avx2(());
 
 /// The AVX-512 instruction set (same lanes as [`Avx2`], compiled with AVX-512 enabled).
+#[cfg(feature = "avx512")]
 #[derive(Clone, Copy, Debug)]
 pub struct Avx512(());
 
@@ -94,6 +97,7 @@ macro_rules! isa {
 }
 
 isa!(Avx2);
+#[cfg(feature = "avx512")]
 isa!(Avx512);
 
 /// Defines a lane type over one register: its arithmetic, and its mask (a register of the same
