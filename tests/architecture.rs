@@ -18,6 +18,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("fault", 2),
     ("stats", 2),
     ("provenance", 2),
+    ("sandbox", 2),
     ("precision", 3),
     ("real", 3),
     ("geometry", 4),
