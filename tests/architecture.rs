@@ -32,6 +32,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("pipeline", 11),
     ("grade", 12),
     ("tradeoff", 12),
+    ("run", 13),
 ];
 
 /// The modules compiled once per precision: inside them, `super::geometry` and the like name a
