@@ -126,7 +126,12 @@ fn hide(dir: &Path, needed: &[&Path], size: u64, p: &mut Protections) {
         Ok(meta) if meta.is_dir() => {}
         _ => return,
     }
-    let inside: Vec<&Path> = needed.iter().copied().filter(|path| path.starts_with(dir)).collect();
+    // A path that does not exist needs no keeping (and must not cost the others their cover).
+    let inside: Vec<&Path> = needed
+        .iter()
+        .copied()
+        .filter(|path| path.starts_with(dir) && fs::symlink_metadata(path).is_ok())
+        .collect();
     let mut trees: Vec<(&Path, OwnedFd, bool)> = Vec::new();
     for path in &inside {
         let is_dir = path.is_dir();
@@ -169,7 +174,7 @@ fn hide(dir: &Path, needed: &[&Path], size: u64, p: &mut Protections) {
                 .and_then(|()| fs::OpenOptions::new().write(true).create_new(true).open(path).map(drop))
         };
         let moved = placed
-            .map_err(rustix::io::Errno::from_io_error_or_io)
+            .map_err(|e| rustix::io::Errno::from_io_error(&e).unwrap_or(rustix::io::Errno::IO))
             .and_then(|()| move_mount(tree, "", CWD, *path, MoveMountFlags::MOVE_MOUNT_F_EMPTY_PATH));
         if let Err(e) = moved {
             let _ = rustix::mount::unmount(dir, rustix::mount::UnmountFlags::DETACH);
@@ -183,15 +188,4 @@ fn hide(dir: &Path, needed: &[&Path], size: u64, p: &mut Protections) {
         placed_trees.push(path);
     }
     p.hidden.push(dir.display().to_string());
-}
-
-/// `Errno` from an `io::Error`, for chaining file and mount steps.
-trait FromIo {
-    fn from_io_error_or_io(error: std::io::Error) -> rustix::io::Errno;
-}
-
-impl FromIo for rustix::io::Errno {
-    fn from_io_error_or_io(error: std::io::Error) -> rustix::io::Errno {
-        rustix::io::Errno::from_io_error(&error).unwrap_or(rustix::io::Errno::IO)
-    }
 }
