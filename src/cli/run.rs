@@ -126,6 +126,14 @@ fn summary(report: &RunReport) -> String {
             format!("; missing {}", missing.join(", "))
         };
         lines.push(format!("  {}: {how}{missing}", command.name));
+        if let Some(last) = command
+            .outcome
+            .as_ref()
+            .and_then(|o| o.stderr_tail.lines().rev().find(|l| !l.trim().is_empty()))
+        {
+            let last: String = last.chars().take(160).collect();
+            lines.push(format!("    stderr: {last}"));
+        }
     }
     for skipped in &record.skipped {
         lines.push(format!("  {}: skipped: {}", skipped.name, skipped.reason));
