@@ -22,6 +22,8 @@ pub mod pipeline;
 pub mod precision;
 pub mod progress;
 pub mod provenance;
+pub mod run;
+pub mod sandbox;
 pub mod simd;
 pub mod stats;
 pub mod tradeoff;

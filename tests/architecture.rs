@@ -18,6 +18,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("fault", 2),
     ("stats", 2),
     ("provenance", 2),
+    ("sandbox", 2),
     ("precision", 3),
     ("real", 3),
     ("geometry", 4),
@@ -31,6 +32,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("pipeline", 11),
     ("grade", 12),
     ("tradeoff", 12),
+    ("run", 13),
 ];
 
 /// The modules compiled once per precision: inside them, `super::geometry` and the like name a

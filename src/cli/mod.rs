@@ -10,6 +10,7 @@ mod import;
 mod mit6837;
 mod progress;
 mod render;
+mod run;
 mod tradeoff;
 
 use std::process::ExitCode;
@@ -45,6 +46,9 @@ enum Command {
     /// reference, and write tradeoff.csv, tradeoff.md and a log-log plot tradeoff.png with the
     /// Pareto front.
     Tradeoff(tradeoff::TradeoffArgs),
+    /// Run a student's program for every course render of a rubric, each command in a sandbox
+    /// with limits, moving the rubric's files into --out with run.json (what each command did).
+    Run(run::RunArgs),
 }
 
 /// Why a command stopped: a command line that cannot be right (exit code 2, like clap's own
@@ -72,6 +76,14 @@ fn asks_for_course_help(args: &[std::ffi::OsString]) -> bool {
 /// Parses the command line (rewriting the course's single-dash flags first), runs the command
 /// and turns its outcome into the process's exit code.
 pub fn main() -> ExitCode {
+    // The sandbox's init, started by the library for each command it runs: first thing, before
+    // anything could start a thread (see goldray::sandbox).
+    if std::env::args_os()
+        .nth(1)
+        .is_some_and(|a| a == goldray::sandbox::INIT_COMMAND)
+    {
+        return run::serve_sandbox_init();
+    }
     let args = course_flags::rewrite(std::env::args_os());
     let cli = match Cli::try_parse_from(&args) {
         Ok(cli) => cli,
@@ -92,6 +104,7 @@ pub fn main() -> ExitCode {
         Command::Diff(args) => Ok(diff::run(args)),
         Command::Grade(args) => grade::run(args),
         Command::Tradeoff(args) => tradeoff::run(args),
+        Command::Run(args) => run::run(args),
     };
     match outcome {
         Ok(code) => code,

@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 
 use super::error::RubricError;
 use super::integrity::{Integrity, integrity};
+use super::run_limits::run_limits;
 use crate::case::{self, AssignmentOptions, Case, LoadOptions, MAX_BOUNCES, load_assignment_scene};
 use crate::fault::Fault;
 use crate::film::Picture;
@@ -17,6 +18,7 @@ use crate::image_size::{MAX_IMAGE_SIZE, SizeLimit, check_side};
 use crate::located_toml::{self, Doc, Field, ReadError, SourceLocation, Table, suggest};
 use crate::named_enum::NamedEnum;
 use crate::named_enum::named_enum;
+use crate::sandbox::LimitOverrides;
 
 /// A whole rubric, every path resolved and every render source loaded.
 #[derive(Clone, Debug)]
@@ -32,6 +34,8 @@ pub struct Rubric {
     /// `[mistake."ID"] credit = c`: the share of an image's points granted when its diagnosis
     /// is that mistake (or a pair of credited mistakes: the product), in file order.
     pub mistake_credit: Vec<(Fault, f64)>,
+    /// `[limits]`: what `goldray run` allows each command of a student's program.
+    pub limits: LimitOverrides,
 }
 
 /// One `[render.NAME]`: a render that one or more images are taken from.
@@ -42,6 +46,19 @@ pub struct RenderSource {
     pub case: Case,
     /// Where the table starts, for errors found only when it renders.
     pub location: SourceLocation,
+    /// What the render was made from, as the rubric gives it.
+    pub origin: RenderOrigin,
+}
+
+/// Where a render comes from. Only a course scene has the course's command line, which
+/// `goldray run` gives a student's program.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RenderOrigin {
+    /// `scene = "…"`: the course scene at this path, with the course binary's flags (`size`,
+    /// `bounces`, `shadows`, `jitter`, `filter`; never depth or normals, which are the images').
+    Course { scene: PathBuf, flags: AssignmentOptions },
+    /// `case = "…"`: the TOML case at this path.
+    Case { path: PathBuf },
 }
 
 /// Which picture of a render an image is, as the course binary writes it.
@@ -123,7 +140,7 @@ const DEFAULT_RULE: Rule = Rule {
 };
 const DEFAULT_POINTS: f64 = 1.0;
 
-const TOP_KEYS: &[&str] = &["title", "defaults", "render", "image", "integrity", "mistake"];
+const TOP_KEYS: &[&str] = &["title", "defaults", "render", "image", "integrity", "mistake", "limits"];
 const RULE_KEYS: &[&str] = &[
     "threshold",
     "pass_fraction",
@@ -192,6 +209,10 @@ pub fn parse_rubric(source: &str, path: &Path) -> Result<Rubric> {
         Some(field) => mistake_credit(&field.table("[mistake]".to_owned())?)?,
         None => Vec::new(),
     };
+    let limits = match top.get("limits") {
+        Some(field) => run_limits(&field.table("[limits]".to_owned())?)?,
+        None => LimitOverrides::default(),
+    };
     if images.is_empty() {
         return Err(RubricError::Missing {
             file: path.to_path_buf(),
@@ -208,6 +229,7 @@ pub fn parse_rubric(source: &str, path: &Path) -> Result<Rubric> {
         images,
         integrity,
         mistake_credit,
+        limits,
     })
 }
 
@@ -251,7 +273,7 @@ fn render_source(entry: &Field) -> Result<RenderSource> {
             Err(f.invalid(format!("must be two whole numbers from 1 to {MAX_IMAGE_SIZE}")))
         }
     })?;
-    let loaded = match (table.get("case"), table.get("scene")) {
+    let (loaded, origin) = match (table.get("case"), table.get("scene")) {
         (Some(case_field), None) => {
             if let Some(stray) = SCENE_ONLY_KEYS.iter().find_map(|k| table.get(k)) {
                 return Err(doc
@@ -265,13 +287,14 @@ fn render_source(entry: &Field) -> Result<RenderSource> {
                     .into());
             }
             let path = doc.dir.join(case_field.string()?);
-            case::load(&path, &LoadOptions::default()).map(|mut case| {
+            let loaded = case::load(&path, &LoadOptions::default()).map(|mut case| {
                 if let Some((width, height)) = size {
                     case.render.trace.width = width;
                     case.render.trace.height = height;
                 }
                 case
-            })
+            });
+            (loaded, RenderOrigin::Case { path })
         }
         (None, Some(scene_field)) => {
             let (width, height) = size.unwrap_or((100, 100));
@@ -285,7 +308,11 @@ fn render_source(entry: &Field) -> Result<RenderSource> {
                 filter: flag("filter")?,
                 ..AssignmentOptions::default()
             };
-            load_assignment_scene(&doc.dir.join(scene_field.string()?), &options)
+            let scene = doc.dir.join(scene_field.string()?);
+            (
+                load_assignment_scene(&scene, &options),
+                RenderOrigin::Course { scene, flags: options },
+            )
         }
         (Some(_), Some(scene_field)) => {
             return Err(doc
@@ -309,7 +336,12 @@ fn render_source(entry: &Field) -> Result<RenderSource> {
         render: name.clone(),
         source: Box::new(source),
     })?;
-    Ok(RenderSource { name, case, location })
+    Ok(RenderSource {
+        name,
+        case,
+        location,
+        origin,
+    })
 }
 
 fn image_spec(entry: &Field, renders: &[RenderSource], base: &Rule, base_points: f64) -> Result<ImageSpec> {

@@ -1,0 +1,44 @@
+//! A rubric's `[limits]`: what `goldray run` allows each student command (wall and CPU time,
+//! memory, file size, processes). Each key replaces the sandbox's default; the command line's
+//! flags replace these.
+
+use std::time::Duration;
+
+use super::error::RubricError;
+use crate::located_toml::{Field, LocatedError, Table};
+use crate::sandbox::{LimitOverrides, parse_bytes, parse_duration};
+
+const LIMIT_KEYS: &[&str] = &["wall_time", "cpu_time", "memory", "file_size", "processes"];
+
+/// `wall_time = 60` or `"90s"`, `memory = "4GiB"` (or a number of bytes), `processes = 256`.
+pub fn run_limits(table: &Table) -> Result<LimitOverrides, RubricError> {
+    table.check_keys(LIMIT_KEYS)?;
+    let time = |f: &Field| -> Result<Option<Duration>, LocatedError> {
+        let text = match f.string() {
+            Ok(text) => text.to_owned(),
+            Err(_) => f.number()?.to_string(),
+        };
+        parse_duration(&text)
+            .map(Some)
+            .map_err(|e| f.error(format!("{}: {e}", f.name)))
+    };
+    let size = |f: &Field| -> Result<Option<u64>, LocatedError> {
+        let text = match f.string() {
+            Ok(text) => text.to_owned(),
+            Err(_) => f.number()?.to_string(),
+        };
+        parse_bytes(&text)
+            .map(Some)
+            .map_err(|e| f.error(format!("{}: {e}", f.name)))
+    };
+    Ok(LimitOverrides {
+        wall: table.read("wall_time", None, time)?,
+        cpu: table.read("cpu_time", None, time)?,
+        memory_bytes: table.read("memory", None, size)?,
+        file_bytes: table.read("file_size", None, size)?,
+        processes: table.read("processes", None, |f| {
+            f.integer_in(1..=1_000_000, "must be a whole number from 1 to 1000000")
+                .map(Some)
+        })?,
+    })
+}
