@@ -44,7 +44,9 @@ fn run(name: &str, action: &str, extra: Option<&str>, limits: &str, dir: &Path) 
         action,
     ];
     args.extend(extra);
-    args.extend(["--out", out.to_str().unwrap(), "--quiet"]);
+    // One command at a time: the well-behaved render must not share the cores with a fork bomb
+    // or an endless loop under a two-second wall limit (on a 2-core machine it could miss it).
+    args.extend(["--out", out.to_str().unwrap(), "--quiet", "--threads", "1"]);
     let (record, _) = run_ok(&args, &out);
     assert_eq!(tree(dir), before, "{name}: files outside the output folder changed");
     let left = processes_with(program.to_str().unwrap());

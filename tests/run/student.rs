@@ -1,6 +1,7 @@
 //! A well-behaved submission: built from C++ sources with `--build`, run through the rubric.
 
 use std::fs;
+use std::path::Path;
 
 use super::{files_in, goldray, outcome, project_file, run_ok, scratch, write_rubric};
 
@@ -124,6 +125,23 @@ fn a_failed_build_runs_nothing_and_says_so() {
     assert_eq!(files_in(&out), ["build.log", "run.json"]);
 }
 
+/// `goldray run` of `/bin/true` through `rubric` into `out`: its exit code and stderr.
+fn run_true(rubric: &Path, out: &Path) -> (Option<i32>, String) {
+    let result = goldray(&[
+        "run",
+        "--rubric",
+        rubric.to_str().unwrap(),
+        "--program",
+        "/bin/true",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    (
+        result.status.code(),
+        String::from_utf8_lossy(&result.stderr).into_owned(),
+    )
+}
+
 #[test]
 fn toml_case_renders_are_skipped_and_bad_limits_are_located_errors() {
     let dir = scratch("rubric-errors");
@@ -138,51 +156,19 @@ fn toml_case_renders_are_skipped_and_bad_limits_are_located_errors() {
     )
     .unwrap();
     let out = dir.join("out");
-    let result = goldray(&[
-        "run",
-        "--rubric",
-        only_case.to_str().unwrap(),
-        "--program",
-        "/bin/true",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    let stderr = String::from_utf8_lossy(&result.stderr);
-    assert_eq!(result.status.code(), Some(1), "{stderr}");
+    let (code, stderr) = run_true(&only_case, &out);
+    assert_eq!(code, Some(1), "{stderr}");
     assert!(
         stderr.contains("nothing to run") && stderr.contains("TOML case"),
         "{stderr}"
     );
 
-    let typo = write_rubric(&dir, "wall_tme = 3");
-    let result = goldray(&[
-        "run",
-        "--rubric",
-        typo.to_str().unwrap(),
-        "--program",
-        "/bin/true",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    let stderr = String::from_utf8_lossy(&result.stderr);
-    assert_eq!(result.status.code(), Some(1), "{stderr}");
+    let (code, stderr) = run_true(&write_rubric(&dir, "wall_tme = 3"), &out);
+    assert_eq!(code, Some(1), "{stderr}");
     assert!(
         stderr.contains("rubric.toml:") && stderr.contains("wall_time"),
         "{stderr}"
     );
-    let bad = write_rubric(&dir, "memory = \"4 parsecs\"");
-    let stderr = String::from_utf8_lossy(
-        &goldray(&[
-            "run",
-            "--rubric",
-            bad.to_str().unwrap(),
-            "--program",
-            "/bin/true",
-            "--out",
-            out.to_str().unwrap(),
-        ])
-        .stderr,
-    )
-    .into_owned();
+    let (_, stderr) = run_true(&write_rubric(&dir, "memory = \"4 parsecs\""), &out);
     assert!(stderr.contains("unknown unit `parsecs`"), "{stderr}");
 }
