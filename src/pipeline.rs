@@ -30,7 +30,7 @@ pub struct Rendered {
 /// written into the outputs. Without it, the same case and binary give byte-identical files; the
 /// record is in the statistics either way.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum RunRecord {
+pub enum RecordRun {
     #[default]
     Omitted,
     InOutputs,
@@ -115,7 +115,7 @@ pub fn output_options(case: &Case) -> OutputOptions {
 /// How a render of `case` is made, for its outputs to carry: this build, the case file's name,
 /// the BLAKE3 hash of the case file and of every asset it reads ([`Case::assets`], in that
 /// order, each framed by its length), and the render settings. This is the stable group only:
-/// commands add the run's record when asked ([`RunRecord`]).
+/// commands add the run's record when asked ([`RecordRun`]).
 pub fn provenance(case: &Case) -> Result<Provenance, Error> {
     let mut hash = ContentHash::default();
     for path in std::iter::once(case.path.clone()).chain(case.assets()) {
@@ -145,7 +145,7 @@ pub fn render_case_file(
     path: &Path,
     out_dir: &Path,
     load: &LoadOptions,
-    record: RunRecord,
+    record: RecordRun,
     progress: &dyn Progress,
 ) -> Result<Rendered, Error> {
     measured_run(
@@ -171,7 +171,7 @@ pub fn render_assignment(
     scene: &Path,
     options: &AssignmentOptions,
     outputs: &AssignmentOutputs,
-    record: RunRecord,
+    record: RecordRun,
     progress: &dyn Progress,
 ) -> Result<Rendered, Error> {
     measured_run(
@@ -191,7 +191,7 @@ fn measured_run(
     load: impl FnOnce() -> Result<Case, Error>,
     progress: &dyn Progress,
     aovs: bool,
-    record: RunRecord,
+    record: RecordRun,
     write: impl FnOnce(&Case, &Film, &Provenance) -> Result<Vec<PathBuf>, Error>,
 ) -> Result<Rendered, Error> {
     let start = Instant::now();
@@ -208,8 +208,8 @@ fn measured_run(
     let measured = measured?;
     let threads = rayon::current_num_threads();
     let provenance = match record {
-        RunRecord::Omitted => provenance?,
-        RunRecord::InOutputs => {
+        RecordRun::Omitted => provenance?,
+        RecordRun::InOutputs => {
             provenance?.with_run(measured.render_time.as_secs_f64(), threads, this_host().as_deref())
         }
     };

@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use goldray::case::LoadOptions;
-use goldray::pipeline::{Rendered, RunRecord, render_case_file};
+use goldray::pipeline::{RecordRun, Rendered, render_case_file};
 
 use super::Failure;
 use super::common::{ThreadFlags, check_writable_file};
@@ -66,11 +66,11 @@ pub fn run(args: RenderArgs) -> Result<ExitCode, Failure> {
 
 impl RunFlags {
     /// Whether the outputs carry the run's record.
-    pub fn record(&self) -> RunRecord {
+    pub fn record(&self) -> RecordRun {
         if self.record_run {
-            RunRecord::InOutputs
+            RecordRun::InOutputs
         } else {
-            RunRecord::Omitted
+            RecordRun::Omitted
         }
     }
 

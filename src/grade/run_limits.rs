@@ -10,24 +10,24 @@ use crate::sandbox::{LimitOverrides, parse_bytes, parse_duration};
 
 const LIMIT_KEYS: &[&str] = &["wall_time", "cpu_time", "memory", "file_size", "processes"];
 
+/// A limit's value as text, whether the rubric wrote a string (`"90s"`) or a bare number (`60`).
+fn text_of(field: &Field) -> Result<String, LocatedError> {
+    match field.string() {
+        Ok(text) => Ok(text.to_owned()),
+        Err(_) => Ok(field.number()?.to_string()),
+    }
+}
+
 /// `wall_time = 60` or `"90s"`, `memory = "4GiB"` (or a number of bytes), `processes = 256`.
 pub fn run_limits(table: &Table) -> Result<LimitOverrides, RubricError> {
     table.check_keys(LIMIT_KEYS)?;
     let time = |f: &Field| -> Result<Option<Duration>, LocatedError> {
-        let text = match f.string() {
-            Ok(text) => text.to_owned(),
-            Err(_) => f.number()?.to_string(),
-        };
-        parse_duration(&text)
+        parse_duration(&text_of(f)?)
             .map(Some)
             .map_err(|e| f.error(format!("{}: {e}", f.name)))
     };
     let size = |f: &Field| -> Result<Option<u64>, LocatedError> {
-        let text = match f.string() {
-            Ok(text) => text.to_owned(),
-            Err(_) => f.number()?.to_string(),
-        };
-        parse_bytes(&text)
+        parse_bytes(&text_of(f)?)
             .map(Some)
             .map_err(|e| f.error(format!("{}: {e}", f.name)))
     };
