@@ -3,7 +3,6 @@
 //! (never pictures) kept until the class-wide report is written. Memory therefore does not grow
 //! with the class beyond a few kilobytes per student.
 
-use std::collections::BTreeMap;
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -20,6 +19,7 @@ use super::rubric::load_rubric;
 use super::score::{Golden, StudentResult, Submission, grade_image};
 use super::shard::{Manifest, Shard, copy_pictures, read_shards, write_manifest};
 use super::similarity::{self, similar_pairs};
+use super::submission::student_folders;
 use super::timing::{RunCost, Timings, timed};
 use super::{Diagnose, GradeOptions, html, integrity};
 use crate::film::OutputError;
@@ -44,7 +44,11 @@ pub fn grade(
     let rubric = load_rubric(rubric_path)?;
     let out = &options.out;
     let cache = options.cache.clone().unwrap_or_else(default_cache_dir);
-    let (folders, ignored) = student_folders(submissions, &[out, &cache])?;
+    let (folders, ignored) =
+        student_folders(submissions, &[out, &cache]).map_err(|source| GradeError::Submissions {
+            path: submissions.to_path_buf(),
+            source,
+        })?;
     let names: Vec<String> = folders.keys().cloned().collect();
     let slugs = report::slugs(&names);
     let range = options.shard.range(names.len());
@@ -317,35 +321,4 @@ fn find_similar(students: &[StudentResult]) -> Vec<similarity::SimilarPair> {
             })
             .collect::<Vec<_>>(),
     )
-}
-
-/// Student folders by name, and the names of the other entries. Hidden entries and `__MACOSX` are
-/// skipped silently, and so are the report and cache directories when they sit inside
-/// `submissions` (so that grading twice does not grade the first report).
-fn student_folders(
-    submissions: &Path,
-    own: &[&PathBuf],
-) -> Result<(BTreeMap<String, PathBuf>, Vec<String>), GradeError> {
-    let error = |source| GradeError::Submissions {
-        path: submissions.to_path_buf(),
-        source,
-    };
-    let own: Vec<PathBuf> = own.iter().filter_map(|p| p.canonicalize().ok()).collect();
-    let mut folders = BTreeMap::new();
-    let mut ignored = Vec::new();
-    for entry in fs::read_dir(submissions).map_err(error)? {
-        let entry = entry.map_err(error)?;
-        let name = entry.file_name().to_string_lossy().into_owned();
-        let path = entry.path();
-        if name.starts_with('.') || name == "__MACOSX" || path.canonicalize().is_ok_and(|p| own.contains(&p)) {
-            continue;
-        }
-        if path.is_dir() {
-            folders.insert(name, path);
-        } else {
-            ignored.push(name);
-        }
-    }
-    ignored.sort();
-    Ok((folders, ignored))
 }

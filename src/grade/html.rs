@@ -10,6 +10,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 mod mistakes;
+mod program;
 
 use super::golden::GOLDEN_DIR;
 use super::outcome::Outcome;
@@ -102,9 +103,10 @@ fn page(title: &str, body: &str) -> String {
     format!(
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
          <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
-         <title>{}</title>\n<style>{STYLE}{}</style>\n</head>\n<body>\n{body}<script>{SCRIPT}</script>\n</body>\n</html>\n",
+         <title>{}</title>\n<style>{STYLE}{}{}</style>\n</head>\n<body>\n{body}<script>{SCRIPT}</script>\n</body>\n</html>\n",
         escape(title),
-        mistakes::STYLE
+        mistakes::STYLE,
+        program::STYLE
     )
 }
 
@@ -297,7 +299,9 @@ const LEGEND: &str = "<p class=\"muted\">\
 <span class=\"badge v-partial\">partial</span> partial credit · \
 <span class=\"badge v-fail\">fail</span> too different from the golden image · \
 <span class=\"badge v-missing\">missing, wrong size, wrong format, too large, unreadable, linked</span> nothing to compare \
-(linked: a symbolic link, or a file outside the student's folder, is not read). \
+(linked: a symbolic link, or a file outside the student's folder, is not read) · \
+<span class=\"badge v-crashed\">crashed, timed out, over limit, exit error, not run</span> the student's program \
+did not make the file (from <code>goldray run</code>'s record). \
 Hover a cell for the reason; click it for the pictures.</p>\n";
 
 fn student_page(report: &ClassReport, student: &StudentResult) -> String {
@@ -327,6 +331,7 @@ fn student_page(report: &ClassReport, student: &StudentResult) -> String {
         );
     }
     body.push_str("</nav>\n");
+    program::summary(&mut body, student);
     mistakes::summary(&mut body, student);
     // Lost points first, the largest share lost first; rubric order among equals.
     let mut order: Vec<&ImageResult> = student.images.iter().collect();

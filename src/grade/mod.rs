@@ -28,6 +28,7 @@ mod golden;
 mod html;
 mod integrity;
 mod outcome;
+mod program_run;
 mod report;
 mod resume;
 mod rubric;
@@ -48,12 +49,14 @@ pub use error::{GradeError, RubricError};
 pub use golden::{CacheMode, GoldenRender, Goldens, default_cache_dir, prepare_goldens, write_golden_pictures};
 pub use integrity::{Integrity, LinkPolicy, PUBLISHED_COPY};
 pub use outcome::Outcome;
+pub use program_run::ProgramRun;
 pub use report::{ClassReport, RubricSummary, diagnoses_of, flags, mistakes_of};
 pub use resume::{RESULT_FILE, StudentRecord};
 pub use rubric::{ImageSpec, Output, RenderOrigin, RenderSource, Rubric, Rule, load_rubric, parse_rubric};
 pub use score::{Golden, ImageResult, StudentResult, Submission, grade_image, judge};
 pub use shard::{MANIFEST, Manifest, Shard, ShardError};
 pub use similarity::{NEAR_IDENTICAL, SimilarPair};
+pub use submission::student_folders;
 pub use timing::{RunCost, Timings};
 
 /// Where the report and the golden cache go, which slice of the class to grade, and whether

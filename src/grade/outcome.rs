@@ -26,6 +26,18 @@ pub enum Outcome {
     /// A symbolic link, or a file that resolves outside the student's folder: not read, because
     /// it is not the student's own file. The reason says where it points.
     Linked { reason: String },
+    /// From `goldray run`'s record: the program that was to write the file was killed by a
+    /// signal (a segfault, an abort).
+    Crashed,
+    /// From the record: the program ran out of wall-clock time.
+    TimedOut,
+    /// From the record: the program hit a limit other than time (memory, CPU, file size,
+    /// processes).
+    OverLimit,
+    /// From the record: the program exited with a non-zero code.
+    ExitError,
+    /// From the record: the program never ran (its build failed, or it was not there).
+    NotRun,
 }
 
 impl Outcome {
@@ -40,6 +52,11 @@ impl Outcome {
             Outcome::TooLarge { .. } => "too large",
             Outcome::Unreadable { .. } => "unreadable",
             Outcome::Linked { .. } => "linked",
+            Outcome::Crashed => "crashed",
+            Outcome::TimedOut => "timed out",
+            Outcome::OverLimit => "over limit",
+            Outcome::ExitError => "exit error",
+            Outcome::NotRun => "not run",
         }
     }
 }

@@ -13,6 +13,7 @@ use super::diagnosis::Diagnosis;
 use super::golden::GOLDEN_DIR;
 use super::integrity::{Integrity, PUBLISHED_COPY, pixel_hash, refuse_link};
 use super::outcome::Outcome;
+use super::program_run::{ProgramRun, absent_verdict, delivered_note, read_run_record};
 use super::rubric::{ImageSpec, Rule};
 use super::similarity::Fingerprint;
 use super::submission::{Folder, read_png};
@@ -20,6 +21,7 @@ use super::timing::{Timings, seconds, timed};
 use crate::atomic_write::replace_file;
 use crate::compare::{Encoding, Image, Metrics, Tolerance, compare_timed, diff_heatmap, diff_heatmap_widened};
 use crate::film::{OutputError, encode_png};
+use crate::sandbox::RunRecord;
 
 /// One expected file of one student.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -48,6 +50,9 @@ pub struct ImageResult {
     /// reference"); it changes the points only where the rubric says so.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub flags: Vec<String>,
+    /// The command behind the image, from `goldray run`'s record, when it did not end well.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub program: Option<ProgramRun>,
     /// What finding copies between students needs; not part of the report.
     #[serde(skip)]
     pub fingerprint: Option<Fingerprint>,
@@ -73,22 +78,28 @@ pub struct Submission {
     pub path: PathBuf,
     pub slug: String,
     files: Folder,
+    /// What `goldray run` recorded when it made this folder's pictures.
+    pub run: Option<RunRecord>,
 }
 
 impl Submission {
     pub fn new(name: String, path: PathBuf, slug: String) -> Submission {
         let files = Folder::scan(&path);
+        let run = read_run_record(&path);
         Submission {
             name,
             path,
             slug,
             files,
+            run,
         }
     }
 
     /// Feeds `hasher` what grading the expected files `names` reads of this submission.
     pub fn hash_inputs<'a>(&self, names: impl Iterator<Item = &'a str>, hasher: &mut impl std::hash::Hasher) {
+        use std::hash::Hash;
         self.files.hash_inputs(names, hasher);
+        serde_json::to_string(&self.run).unwrap_or_default().hash(hasher);
     }
 
     /// Where the student's pictures go, relative to the report directory.
@@ -158,14 +169,30 @@ pub fn grade_image(
         metrics: None,
         diagnosis: None,
         flags: Vec::new(),
+        program: None,
         fingerprint: None,
     };
     let located = match (&folder.error, folder.find(&spec.file)) {
         (Some(reason), _) => return Ok(refused(result, Outcome::Unreadable { reason: reason.clone() })),
-        (None, None) => return Ok(refused(result, Outcome::Missing)),
+        (None, None) => {
+            let why = submission.run.as_ref().and_then(|run| absent_verdict(run, &spec.file));
+            return Ok(match why {
+                Some((outcome, explanation, program)) => {
+                    let mut result = refused(result, outcome);
+                    result.explanation = explanation;
+                    result.program = Some(program);
+                    result
+                }
+                None => refused(result, Outcome::Missing),
+            });
+        }
         (None, Some(located)) => located,
     };
     result.notes.extend(located.note);
+    if let Some((note, program)) = submission.run.as_ref().and_then(|run| delivered_note(run, &spec.file)) {
+        result.notes.push(note);
+        result.program = Some(program);
+    }
     result.graded_file = Some(located.path.clone());
     if let Some(reason) = refuse_link(&located.path, &submission.path, integrity.links) {
         return Ok(refused(result, Outcome::Linked { reason }));
@@ -309,6 +336,9 @@ fn refused(mut result: ImageResult, outcome: Outcome) -> ImageResult {
         ),
         Outcome::WrongFormat { found } => format!("the file is {found}, not a PNG"),
         Outcome::TooLarge { reason } | Outcome::Unreadable { reason } | Outcome::Linked { reason } => reason.clone(),
+        Outcome::Crashed | Outcome::TimedOut | Outcome::OverLimit | Outcome::ExitError | Outcome::NotRun => {
+            format!("no {}: {}", result.file, outcome.word())
+        }
         Outcome::Pass | Outcome::Partial | Outcome::Fail => String::new(),
     };
     result.outcome = outcome;

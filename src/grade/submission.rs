@@ -10,6 +10,7 @@
 //! palette and low bit depths (expanded). Students are graded on their pixels, not on how their
 //! PNG library chose to store them.
 
+use std::collections::BTreeMap;
 use std::fs::{self, File};
 use std::hash::{Hash, Hasher};
 use std::io::{Cursor, Read};
@@ -137,6 +138,34 @@ impl Folder {
             bytes.map(|b| *blake3::hash(&b).as_bytes()).hash(hasher);
         }
     }
+}
+
+/// Student folders of a class folder by name, and the names of the other entries. Hidden
+/// entries and `__MACOSX` are skipped silently, and so are the folders of `own` (a report or a
+/// cache) when they sit inside `submissions`, so that grading twice does not grade the first
+/// report.
+pub fn student_folders(
+    submissions: &Path,
+    own: &[&PathBuf],
+) -> std::io::Result<(BTreeMap<String, PathBuf>, Vec<String>)> {
+    let own: Vec<PathBuf> = own.iter().filter_map(|p| p.canonicalize().ok()).collect();
+    let mut folders = BTreeMap::new();
+    let mut ignored = Vec::new();
+    for entry in fs::read_dir(submissions)? {
+        let entry = entry?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let path = entry.path();
+        if name.starts_with('.') || name == "__MACOSX" || path.canonicalize().is_ok_and(|p| own.contains(&p)) {
+            continue;
+        }
+        if path.is_dir() {
+            folders.insert(name, path);
+        } else {
+            ignored.push(name);
+        }
+    }
+    ignored.sort();
+    Ok((folders, ignored))
 }
 
 /// A decoded submission: 8-bit RGB plus what was done to get there.

@@ -8,6 +8,7 @@
 //! An optional build command first runs in a fresh copy of the submission, under the same
 //! limits and sandbox; the program is then taken from that copy.
 
+mod class;
 mod command;
 mod error;
 mod layout;
@@ -18,14 +19,15 @@ use std::path::{Path, PathBuf};
 
 use rayon::prelude::*;
 
+pub use class::{ClassRunOptions, ClassRunReport, StudentRun, StudentState, run_class};
 pub use command::{CourseCommand, DATA, plan};
 pub use error::RunError;
-pub use submission::{Program, copy_submission, resolve, submission_folder};
+pub use submission::{Program, copy_submission, hash_submission, resolve, submission_folder};
 
 use crate::atomic_write::{check_writable_folder, write_file_atomic};
 use crate::grade::load_rubric;
 use crate::progress::Progress;
-use crate::sandbox::{CommandRecord, Job, LimitOverrides, Limits, Outcome, RUN_RECORD, RunRecord, Sandbox};
+use crate::sandbox::{CommandRecord, Job, LimitOverrides, Limits, Outcome, RUN_RECORD, RunRecord, Sandbox, Skipped};
 
 /// The build's log in the output folder.
 pub const BUILD_LOG: &str = "build.log";
@@ -54,10 +56,20 @@ pub struct RunReport {
     pub out: PathBuf,
 }
 
-/// Runs the program of `options` for every course render of the rubric at `rubric_path`, in
-/// parallel on the current rayon pool (one command per worker), and writes the outputs and
-/// `run.json` into `options.out`.
-pub fn run_rubric(rubric_path: &Path, options: &RunOptions, progress: &dyn Progress) -> Result<RunReport, RunError> {
+/// A rubric's commands, ready to run for any number of submissions.
+#[derive(Clone, Debug)]
+pub struct Plan {
+    pub commands: Vec<CourseCommand>,
+    pub skipped: Vec<Skipped>,
+    pub limits: Limits,
+    /// The digest of everything of the rubric's that a run depends on: the commands, the
+    /// limits, and the bytes of every scene and asset laid out.
+    digest: blake3::Hash,
+}
+
+/// The commands of the rubric at `rubric_path` and the limits they run under (`overrides`, then
+/// the rubric's `[limits]`, then the defaults).
+pub fn plan_run(rubric_path: &Path, overrides: &LimitOverrides) -> Result<Plan, RunError> {
     let rubric = load_rubric(rubric_path)?;
     let (commands, skipped) = plan(&rubric)?;
     if commands.is_empty() {
@@ -67,28 +79,116 @@ pub fn run_rubric(rubric_path: &Path, options: &RunOptions, progress: &dyn Progr
             reasons: reasons.join("; "),
         });
     }
-    let limits = rubric.limits.then(&options.limits).apply(&Limits::default());
+    let limits = rubric.limits.then(overrides).apply(&Limits::default());
+    let mut hasher = blake3::Hasher::new();
+    hasher.update(env!("CARGO_PKG_VERSION").as_bytes());
+    hasher.update(serde_json::to_string(&limits).unwrap_or_default().as_bytes());
+    for command in &commands {
+        hasher.update(format!("{:?}", (&command.args, &command.outputs)).as_bytes());
+        let files = std::iter::once(&command.scene).chain(command.assets.iter().map(|(source, _)| source));
+        for file in files {
+            hash_file(&mut hasher, file);
+        }
+    }
+    Ok(Plan {
+        commands,
+        skipped,
+        limits,
+        digest: hasher.finalize(),
+    })
+}
+
+fn hash_file(hasher: &mut blake3::Hasher, path: &Path) {
+    hasher.update(path.as_os_str().as_encoded_bytes());
+    match fs::read(path) {
+        Ok(bytes) => hasher.update(&[1]).update(blake3::hash(&bytes).as_bytes()),
+        Err(_) => hasher.update(&[0]),
+    };
+}
+
+/// Runs the program of `options` for every course render of the rubric at `rubric_path`, in
+/// parallel on the current rayon pool (one command per worker), and writes the outputs and
+/// `run.json` into `options.out`.
+pub fn run_rubric(rubric_path: &Path, options: &RunOptions, progress: &dyn Progress) -> Result<RunReport, RunError> {
+    let plan = plan_run(rubric_path, &options.limits)?;
     check_writable_folder(&options.out)?;
     fs::create_dir_all(&options.out).map_err(RunError::io("create", &options.out))?;
     let first = options.program.first().ok_or(RunError::NoProgram)?;
     let original = submission_folder(first, options.submission.as_deref());
+    if options.build.is_some() && original.is_none() {
+        return Err(RunError::NeedsSubmission);
+    }
+    // Without a build the program is found before anything runs: a mistyped path is the TA's
+    // error, not a verdict on the student.
+    if options.build.is_none() {
+        resolve(&options.program, original.as_deref(), None)?;
+    }
+    let target = Target {
+        program: &options.program,
+        build: options.build.as_deref(),
+        sandbox: &options.sandbox,
+        student: None,
+    };
+    let inputs = inputs_digest(&plan, &target, original.as_deref())?;
+    progress.begin("running", plan.commands.len() as u64);
+    let record = run_submission(&plan, &target, original.as_deref(), &options.out, inputs, progress);
+    progress.finish();
+    let record = record?;
+    Ok(RunReport {
+        record,
+        limits: plan.limits,
+        out: options.out.clone(),
+    })
+}
+
+/// What runs for a submission.
+struct Target<'a> {
+    program: &'a [String],
+    build: Option<&'a str>,
+    sandbox: &'a Sandbox,
+    /// In a class, the student's name: the program then names a file of the student's own
+    /// submission (not a path from the current folder), and progress names the student.
+    student: Option<&'a str>,
+}
+
+impl Target<'_> {
+    fn label(&self, what: &str) -> String {
+        match self.student {
+            Some(student) => format!("{student}: {what}"),
+            None => what.to_owned(),
+        }
+    }
+}
+
+/// Builds (when asked) and runs one submission's program for every command of `plan`, delivers
+/// the outputs into `out` and writes `run.json` there, with `inputs` (see [`inputs_digest`]).
+fn run_submission(
+    plan: &Plan,
+    target: &Target,
+    original: Option<&Path>,
+    out: &Path,
+    inputs: String,
+    progress: &dyn Progress,
+) -> Result<RunRecord, RunError> {
     let scratch = tempfile::Builder::new()
         .prefix("goldray-run-")
         .tempdir()
         .map_err(RunError::io("create a temporary folder in", std::env::temp_dir()))?;
-
-    let (program, build) = match &options.build {
-        None => (resolve(&options.program, original.as_deref(), None)?, None),
-        Some(command) => {
-            let original = original.as_deref().ok_or(RunError::NeedsSubmission)?;
+    let (program, build) = match (target.build, original) {
+        (Some(command), Some(original)) => {
             let copy = scratch.path().join("submission");
             copy_submission(original, &copy)?;
-            progress.step("build");
-            let record = build_in(&copy, command, &limits, &options.sandbox);
-            write_file_atomic(&options.out.join(BUILD_LOG), build_log(&record).as_bytes())?;
-            progress.done("build");
-            (resolve(&options.program, Some(original), Some(&copy))?, Some(record))
+            progress.step(&target.label("build"));
+            let record = build_in(&copy, command, &plan.limits, target.sandbox);
+            write_file_atomic(&out.join(BUILD_LOG), build_log(&record).as_bytes())?;
+            progress.done(&target.label("build"));
+            (resolve(target.program, Some(original), Some(&copy))?, Some(record))
         }
+        (Some(_), None) => return Err(RunError::NeedsSubmission),
+        (None, Some(original)) if target.student.is_some() => {
+            (resolve(target.program, Some(original), Some(original))?, None)
+        }
+        (None, _) => (resolve(target.program, original, None)?, None),
     };
     let not_run = match &build {
         Some(record) if !record.outcome.as_ref().is_some_and(Outcome::succeeded) => {
@@ -101,32 +201,48 @@ pub fn run_rubric(rubric_path: &Path, options: &RunOptions, progress: &dyn Progr
         )),
         _ => None,
     };
-
-    progress.begin("running", commands.len() as u64);
-    let records: Vec<CommandRecord> = commands
+    let records: Vec<CommandRecord> = plan
+        .commands
         .par_iter()
         .map(|command| {
-            let record = run_command(command, &program, not_run.as_deref(), scratch.path(), options, &limits);
+            let record = run_command(
+                command,
+                &program,
+                not_run.as_deref(),
+                scratch.path(),
+                target,
+                out,
+                &plan.limits,
+            );
             progress.advance(1);
-            progress.done(&command.name);
+            progress.done(&target.label(&command.name));
             record
         })
         .collect();
-    progress.finish();
     let record = RunRecord {
         goldray: env!("CARGO_PKG_VERSION").to_owned(),
-        limits: limits.clone(),
+        limits: plan.limits.clone(),
+        inputs: Some(inputs),
         build,
         commands: records,
-        skipped,
+        skipped: plan.skipped.clone(),
     };
     let json = serde_json::to_vec_pretty(&record).unwrap_or_default();
-    write_file_atomic(&options.out.join(RUN_RECORD), &json)?;
-    Ok(RunReport {
-        record,
-        limits,
-        out: options.out.clone(),
-    })
+    write_file_atomic(&out.join(RUN_RECORD), &json)?;
+    Ok(record)
+}
+
+/// What a submission's run depends on, as hex: the plan, the program and build command, and
+/// every file of the submission (a student whose sources and rubric have not changed need not be
+/// built and run again).
+fn inputs_digest(plan: &Plan, target: &Target, original: Option<&Path>) -> Result<String, RunError> {
+    let mut hasher = blake3::Hasher::new();
+    hasher.update(plan.digest.as_bytes());
+    hasher.update(format!("{:?}", (target.program, target.build, target.student.is_some())).as_bytes());
+    if let Some(folder) = original {
+        hash_submission(folder, &mut hasher)?;
+    }
+    Ok(hasher.finalize().to_hex().to_string())
 }
 
 /// One course command: a fresh folder, the program in the sandbox, the outputs delivered, the
@@ -136,7 +252,8 @@ fn run_command(
     program: &Program,
     not_run: Option<&str>,
     scratch: &Path,
-    options: &RunOptions,
+    target: &Target,
+    out: &Path,
     limits: &Limits,
 ) -> CommandRecord {
     let mut job_args = program.args.clone();
@@ -155,7 +272,7 @@ fn run_command(
         let prepared = fs::create_dir(&work)
             .map_err(RunError::io("create", &work))
             .and_then(|()| layout::lay_out(&work, command));
-        match prepared.map(|()| options.sandbox.run(&job, limits)) {
+        match prepared.map(|()| target.sandbox.run(&job, limits)) {
             Ok(Ok(outcome)) => record.outcome = Some(outcome),
             Ok(Err(e)) => record.not_run = Some(format!("the sandbox failed: {e}")),
             Err(e) => record.not_run = Some(format!("not run: {e}")),
@@ -164,7 +281,7 @@ fn run_command(
     record.outputs = command
         .outputs
         .iter()
-        .map(|file| layout::deliver(&work, file, &options.out, limits.file_bytes))
+        .map(|file| layout::deliver(&work, file, out, limits.file_bytes))
         .collect();
     let _ = fs::remove_dir_all(&work);
     record

@@ -93,17 +93,60 @@ pub fn copy_submission(from: &Path, to: &Path) -> Result<(), RunError> {
     copy_tree(from, to, &mut count)
 }
 
+/// Feeds `hasher` every entry of the submission folder `folder`: relative paths in name order,
+/// each file's bytes (through its own BLAKE3 digest), each link's target (never followed).
+pub fn hash_submission(folder: &Path, hasher: &mut blake3::Hasher) -> Result<(), RunError> {
+    let mut count = 0;
+    hash_tree(folder, Path::new(""), hasher, &mut count)
+}
+
+fn hash_tree(root: &Path, relative: &Path, hasher: &mut blake3::Hasher, count: &mut usize) -> Result<(), RunError> {
+    let dir = root.join(relative);
+    let mut entries = fs::read_dir(&dir)
+        .map_err(RunError::io("list", &dir))?
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(RunError::io("list", &dir))?;
+    entries.sort_by_key(|entry| entry.file_name());
+    for entry in entries {
+        *count += 1;
+        if *count > MAX_ENTRIES {
+            return Err(too_many(root));
+        }
+        let path = relative.join(entry.file_name());
+        let source = entry.path();
+        let kind = entry.file_type().map_err(RunError::io("read", &source))?;
+        hasher.update(path.as_os_str().as_encoded_bytes());
+        if kind.is_dir() {
+            hasher.update(b"/");
+            hash_tree(root, &path, hasher, count)?;
+        } else if kind.is_file() {
+            let file = fs::File::open(&source).map_err(RunError::io("read", &source))?;
+            let mut digest = blake3::Hasher::new();
+            digest.update_reader(file).map_err(RunError::io("read", &source))?;
+            hasher.update(b"=").update(digest.finalize().as_bytes());
+        } else if kind.is_symlink() {
+            let link = fs::read_link(&source).map_err(RunError::io("read", &source))?;
+            hasher.update(b"->").update(link.as_os_str().as_encoded_bytes());
+        }
+    }
+    Ok(())
+}
+
+fn too_many(folder: &Path) -> RunError {
+    RunError::Io {
+        what: "take the submission",
+        path: folder.to_path_buf(),
+        source: std::io::Error::other(format!("more than {MAX_ENTRIES} files")),
+    }
+}
+
 fn copy_tree(from: &Path, to: &Path, count: &mut usize) -> Result<(), RunError> {
     fs::create_dir_all(to).map_err(RunError::io("create", to))?;
     for entry in fs::read_dir(from).map_err(RunError::io("list", from))? {
         let entry = entry.map_err(RunError::io("list", from))?;
         *count += 1;
         if *count > MAX_ENTRIES {
-            return Err(RunError::Io {
-                what: "copy the submission",
-                path: from.to_path_buf(),
-                source: std::io::Error::other(format!("more than {MAX_ENTRIES} files")),
-            });
+            return Err(too_many(from));
         }
         let (source, target) = (entry.path(), to.join(entry.file_name()));
         let kind = entry.file_type().map_err(RunError::io("read", &source))?;

@@ -17,6 +17,10 @@ pub struct RunRecord {
     /// goldray's version that ran the commands.
     pub goldray: String,
     pub limits: Limits,
+    /// The digest of what the run depended on (rubric, scenes, program, build command, the
+    /// submission's files): a later run with the same digest need not run again.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inputs: Option<String>,
     /// The build command, when there was one.
     pub build: Option<CommandRecord>,
     pub commands: Vec<CommandRecord>,
