@@ -1,6 +1,6 @@
 //! What the command's own process does to itself just before it becomes the program: gives up
-//! every capability, enters Landlock, and sets its resource limits. All of it is inherited by
-//! the program and everything it starts, and none of it can be undone.
+//! every capability, enters Landlock, sets its resource limits and installs the seccomp filter.
+//! All of it is inherited by the program and everything it starts, and none of it can be undone.
 
 use rustix::process::{Resource, Rlimit, getrlimit, getuid, setrlimit};
 use rustix::thread::{
@@ -20,6 +20,10 @@ pub fn confine(request: &Request, outside_uid: u32, p: &mut Protections) {
         Err(e) => p.unavailable.push(format!("no_new_privs: {e}")),
     }
     set_limits(request, outside_uid, p);
+    match super::seccomp::restrict() {
+        Ok(()) => p.seccomp = true,
+        Err(e) => p.unavailable.push(format!("seccomp: {e}")),
+    }
 }
 
 /// No capability now, none in the bounding set, and (with the `NO_ROOT` secure bit) none granted

@@ -7,7 +7,8 @@
 //!      │                          keeps the output's tail, enforces the wall time, reports
 //!      └─ first process           PID 1 of the new PID namespace: mounts, then waits; its end
 //!          │                      kills every process left in the namespace
-//!          └─ the command         drops capabilities, enters Landlock, sets rlimits, execs
+//!          └─ the command         drops capabilities, enters Landlock, sets rlimits,
+//!                                 installs the seccomp filter, execs
 //! ```
 //!
 //! Every layer is tried on its own and the run never refuses to happen: where the machine lacks
@@ -16,7 +17,8 @@
 //! capability outside), mount, PID, network, IPC and UTS namespaces, the usual folders of other
 //! users and services hidden (`/tmp`, `/run`, `/home`…), its own `/proc`, Landlock (write only in
 //! the working folder; read only the system's programs and libraries and the job's own paths; no
-//! TCP), no capabilities, `no_new_privs`, and rlimits (CPU, address space, file size, processes,
+//! TCP), no capabilities, `no_new_privs`, a seccomp filter (no tracing, kernel modules, BPF,
+//! `io_uring`, new namespaces or mounts), and rlimits (CPU, address space, file size, processes,
 //! no core files). The wall time is enforced by the init on every machine.
 //!
 //! The init is the `goldray` binary itself, started with the hidden command [`INIT_COMMAND`]: a
@@ -40,6 +42,8 @@ mod landlock;
 #[cfg(target_os = "linux")]
 mod namespaces;
 mod protocol;
+#[cfg(target_os = "linux")]
+mod seccomp;
 mod spawn;
 
 use std::path::PathBuf;

@@ -106,6 +106,10 @@ pub struct Protections {
     pub no_new_privs: bool,
     /// No capability, and none granted by running a program as root.
     pub capabilities_dropped: bool,
+    /// The seccomp filter: tracing, kernel modules, BPF, `io_uring`, new namespaces and mounts
+    /// and the like are refused (see `sandbox::seccomp`).
+    #[serde(default)]
+    pub seccomp: bool,
     /// The resource limits set (`cpu`, `address-space`, `file-size`, `processes`, `core`).
     pub rlimits: Vec<String>,
     /// How the number of processes is bounded, in words (`RLIMIT_NPROC 256`, `pid_max 301`), or
@@ -171,6 +175,9 @@ impl Protections {
         }
         if self.capabilities_dropped {
             parts.push("no capabilities".to_owned());
+        }
+        if self.seccomp {
+            parts.push("seccomp".to_owned());
         }
         if !self.rlimits.is_empty() {
             parts.push(format!("rlimits: {}", self.rlimits.join(", ")));

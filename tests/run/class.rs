@@ -193,7 +193,10 @@ fn a_class_is_built_run_and_graded_with_every_failure_named_and_reruns_only_what
         let dave = image(&grades, "dave", file);
         assert_eq!(dave["verdict"], "timed_out", "{dave:#}");
         assert!(
-            dave["explanation"].as_str().unwrap().starts_with("timed out after 10 s"),
+            dave["explanation"]
+                .as_str()
+                .unwrap()
+                .starts_with("timed out after 10 s"),
             "{dave:#}"
         );
         assert_eq!(

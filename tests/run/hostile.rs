@@ -236,6 +236,34 @@ fn a_connection_to_the_host_fails() {
 }
 
 #[test]
+fn the_system_calls_exploits_start_from_are_refused() {
+    let dir = scratch("syscalls");
+    let h = run("syscalls", "syscalls", None, "wall_time = 10", &dir);
+    let o = scene01(&h);
+    assert!(h.said.contains("fork: works"), "{}", h.said);
+    if o.protections.seccomp {
+        for call in [
+            "unshare",
+            "ptrace",
+            "io_uring_setup",
+            "bpf",
+            "perf_event_open",
+            "userfaultfd",
+            "keyctl",
+            "clone(CLONE_NEWUSER)",
+        ] {
+            assert!(h.said.contains(&format!("{call}: refused")), "{call}:\n{}", h.said);
+        }
+        assert!(!h.said.contains("ALLOWED"), "{}", h.said);
+    } else {
+        assert!(
+            o.protections.unavailable.iter().any(|u| u.starts_with("seccomp")),
+            "{o:#?}"
+        );
+    }
+}
+
+#[test]
 fn a_process_left_behind_is_killed() {
     let dir = scratch("linger");
     let marker = dir.join("out-of-reach-marker");

@@ -11,7 +11,11 @@
 #include <fstream>
 #include <netinet/in.h>
 #include <string>
+#include <sched.h>
+#include <sys/ptrace.h>
 #include <sys/socket.h>
+#include <sys/syscall.h>
+#include <sys/wait.h>
 #include <unistd.h>
 #include <vector>
 
@@ -80,6 +84,29 @@ static std::string act(const std::string& action, const std::string& extra) {
             _exit(0);
         }
         return "left a process behind\n";
+    } else if (action == "syscalls") {
+        // What kernel exploits start from: each attempt reports whether the kernel let it through.
+        auto attempt = [](const char* what, long result) {
+            return std::string(what) + (result == -1 ? ": refused (" + std::string(std::strerror(errno)) + ")\n"
+                                                     : ": ALLOWED\n");
+        };
+        std::string said = attempt("unshare", unshare(CLONE_NEWUSER | CLONE_NEWNS));
+        said += attempt("ptrace", ptrace(PTRACE_TRACEME, 0, nullptr, nullptr));
+        said += attempt("io_uring_setup", syscall(SYS_io_uring_setup, 8, nullptr));
+        said += attempt("bpf", syscall(SYS_bpf, 0, nullptr, 0));
+        said += attempt("perf_event_open", syscall(SYS_perf_event_open, nullptr, 0, -1, -1, 0));
+        said += attempt("userfaultfd", syscall(SYS_userfaultfd, 0));
+        said += attempt("keyctl", syscall(SYS_keyctl, 0, 0, 0, 0, 0));
+        long child = syscall(SYS_clone, (long)(CLONE_NEWUSER | SIGCHLD), nullptr, nullptr, nullptr, nullptr);
+        if (child == 0) _exit(0);
+        if (child > 0) waitpid(child, nullptr, 0);
+        said += attempt("clone(CLONE_NEWUSER)", child);
+        // An ordinary child still works.
+        pid_t plain = fork();
+        if (plain == 0) _exit(0);
+        if (plain > 0) waitpid(plain, nullptr, 0);
+        said += std::string("fork: ") + (plain > 0 ? "works\n" : "FAILED\n");
+        return said;
     } else if (action == "abort") {
         std::fprintf(stderr, "about to abort\n");
         std::fflush(stderr);
