@@ -7,6 +7,7 @@
 
 pub mod assignment_outputs;
 pub mod atomic_write;
+pub mod autograde;
 pub mod build_error;
 pub mod case;
 pub mod compare;

@@ -14,6 +14,8 @@ mod cli;
 mod integrity;
 #[path = "grade/memory.rs"]
 mod memory;
+#[path = "grade/platform.rs"]
+mod platform;
 #[path = "grade/rubrics.rs"]
 mod rubrics;
 #[path = "grade/scale.rs"]

@@ -5,6 +5,8 @@
 //! still done; crashes and exit codes recorded with their stderr. Where the machine lacks a
 //! protection, the tests check that the report says so instead.
 
+#[path = "run/autograde.rs"]
+mod autograde;
 #[path = "run/class.rs"]
 mod class;
 #[path = "run/hostile.rs"]

@@ -1,9 +1,12 @@
 //! Flags and value parsers that several commands share, each written once so that every
 //! command spells and checks them the same way.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
 
+use goldray::grade::ProgramSection;
 use goldray::image_size::{SizeLimit, check_side};
+use goldray::sandbox::{LimitOverrides, parse_bytes, parse_duration};
 
 /// `--threads N`, the same on every command that works in parallel.
 #[derive(Clone, Debug, clap::Args)]
@@ -25,6 +28,67 @@ impl ThreadFlags {
             .map_err(|e| format!("cannot start worker threads: {e}"))?;
         Ok(pool.install(work))
     }
+}
+
+/// The limits of every command a student's program runs (`run`, `check --program`,
+/// `autograde`); each replaces the rubric's `[limits]`, which replace the defaults.
+#[derive(Clone, Debug, clap::Args)]
+pub struct LimitFlags {
+    /// Wall-clock time per command [default: 60s, or the rubric's [limits] wall_time].
+    #[arg(long, value_parser = parse_duration, value_name = "TIME")]
+    wall_time: Option<Duration>,
+    /// CPU time per process [default: 60s].
+    #[arg(long, value_parser = parse_duration, value_name = "TIME")]
+    cpu_time: Option<Duration>,
+    /// Address space per process [default: 4GiB].
+    #[arg(long, value_parser = parse_bytes, value_name = "SIZE")]
+    memory: Option<u64>,
+    /// Size of any file written [default: 512MiB].
+    #[arg(long, value_parser = parse_bytes, value_name = "SIZE")]
+    file_size: Option<u64>,
+    /// Processes and threads per command [default: 256].
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1_000_000), value_name = "N")]
+    processes: Option<u64>,
+}
+
+impl LimitFlags {
+    pub fn overrides(&self) -> LimitOverrides {
+        LimitOverrides {
+            wall: self.wall_time,
+            cpu: self.cpu_time,
+            memory_bytes: self.memory,
+            file_bytes: self.file_size,
+            processes: self.processes,
+        }
+    }
+}
+
+/// `--program` and `--build` for grading one submission from its program (`check`,
+/// `autograde`): when given, they replace the rubric's `[program]`.
+#[derive(Clone, Debug, clap::Args)]
+pub struct ProgramFlags {
+    /// Build and run the student's program first, as `goldray run` does, and grade its outputs:
+    /// a path inside the submission or a command with arguments [default: the rubric's
+    /// [program] command, if any; else the folder's pictures are graded].
+    #[arg(long, num_args = 1.., value_name = "PROGRAM [ARGS]")]
+    pub program: Option<Vec<String>>,
+    /// The build command for --program, run with `sh -c` in a copy of the submission.
+    #[arg(long, value_name = "CMD", requires = "program")]
+    pub build: Option<String>,
+}
+
+impl ProgramFlags {
+    pub fn section(&self) -> Option<ProgramSection> {
+        self.program.clone().map(|command| ProgramSection {
+            command,
+            build: self.build.clone(),
+        })
+    }
+}
+
+/// goldray's own binary, which the sandbox starts as the init of every command it runs.
+pub fn own_binary() -> Result<PathBuf, String> {
+    std::env::current_exe().map_err(|e| format!("cannot find goldray's own binary for the sandbox: {e}"))
 }
 
 /// A limit: a finite number ≥ 0 (a NaN limit would pass everything, because every comparison

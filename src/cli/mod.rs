@@ -2,6 +2,8 @@
 //! The library below neither parses flags nor prints; each command here is one file that turns
 //! flags into library options, runs the library, and reports.
 
+mod autograde;
+mod check;
 mod common;
 mod course_flags;
 mod diff;
@@ -49,6 +51,13 @@ enum Command {
     /// Run a student's program for every course render of a rubric, each command in a sandbox
     /// with limits, moving the rubric's files into --out with run.json (what each command did).
     Run(run::RunArgs),
+    /// A student's self-check: grade one folder (or what its program renders) against the
+    /// course's rubric and print the points, the mistakes named and where to look. Exit code 0
+    /// at full points, 1 otherwise.
+    Check(check::CheckArgs),
+    /// Gradescope's autograder: grade /autograder/submission (building and running the program
+    /// first when the rubric has a [program]) and write /autograder/results/results.json.
+    Autograde(autograde::AutogradeArgs),
 }
 
 /// Why a command stopped: a command line that cannot be right (exit code 2, like clap's own
@@ -105,6 +114,8 @@ pub fn main() -> ExitCode {
         Command::Grade(args) => grade::run(args),
         Command::Tradeoff(args) => tradeoff::run(args),
         Command::Run(args) => run::run(args),
+        Command::Check(args) => check::run(args),
+        Command::Autograde(args) => autograde::run(args),
     };
     match outcome {
         Ok(code) => code,

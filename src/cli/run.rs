@@ -4,14 +4,13 @@
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::time::Duration;
 
 use goldray::run::{ClassRunOptions, ClassRunReport, RunOptions, RunReport, StudentState, run_class, run_rubric};
 use goldray::sandbox::{CommandRecord, Limits, RunRecord};
-use goldray::sandbox::{LimitOverrides, Sandbox, describe_limits, parse_bytes, parse_duration, serve_init};
+use goldray::sandbox::{Sandbox, describe_limits, serve_init};
 
 use super::Failure;
-use super::common::ThreadFlags;
+use super::common::{LimitFlags, ThreadFlags, own_binary};
 use super::progress::Reporter;
 
 #[derive(Clone, Debug, clap::Args)]
@@ -46,35 +45,16 @@ pub struct RunArgs {
     build: Option<String>,
     #[command(flatten)]
     threads: ThreadFlags,
-    /// Wall-clock time per command [default: 60s, or the rubric's [limits] wall_time].
-    #[arg(long, value_parser = parse_duration, value_name = "TIME")]
-    wall_time: Option<Duration>,
-    /// CPU time per process [default: 60s].
-    #[arg(long, value_parser = parse_duration, value_name = "TIME")]
-    cpu_time: Option<Duration>,
-    /// Address space per process [default: 4GiB].
-    #[arg(long, value_parser = parse_bytes, value_name = "SIZE")]
-    memory: Option<u64>,
-    /// Size of any file written [default: 512MiB].
-    #[arg(long, value_parser = parse_bytes, value_name = "SIZE")]
-    file_size: Option<u64>,
-    /// Processes and threads per command [default: 256].
-    #[arg(long, value_parser = clap::value_parser!(u64).range(1..=1_000_000), value_name = "N")]
-    processes: Option<u64>,
+    #[command(flatten)]
+    limits: LimitFlags,
     /// No progress and no summary.
     #[arg(long)]
     quiet: bool,
 }
 
 pub fn run(args: RunArgs) -> Result<ExitCode, Failure> {
-    let init = std::env::current_exe().map_err(|e| format!("cannot find goldray's own binary for the sandbox: {e}"))?;
-    let limits = LimitOverrides {
-        wall: args.wall_time,
-        cpu: args.cpu_time,
-        memory_bytes: args.memory,
-        file_bytes: args.file_size,
-        processes: args.processes,
-    };
+    let init = own_binary()?;
+    let limits = args.limits.overrides();
     let reporter = Reporter::new(args.quiet);
     if let Some(programs) = &args.programs {
         let options = ClassRunOptions {

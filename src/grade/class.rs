@@ -3,6 +3,7 @@
 //! (never pictures) kept until the class-wide report is written. Memory therefore does not grow
 //! with the class beyond a few kilobytes per student.
 
+use std::collections::BTreeMap;
 use std::fs;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -15,7 +16,7 @@ use super::error::GradeError;
 use super::golden::{CacheMode, default_cache_dir, prepare_goldens, write_golden_pictures};
 use super::report::{self, ClassReport, RubricSummary};
 use super::resume::{StudentRecord, read_record, run_fingerprint, student_fingerprint, write_record};
-use super::rubric::load_rubric;
+use super::rubric::{Rubric, load_rubric};
 use super::score::{Golden, StudentResult, Submission, grade_image};
 use super::shard::{Manifest, Shard, copy_pictures, read_shards, write_manifest};
 use super::similarity::{self, similar_pairs};
@@ -42,13 +43,70 @@ pub fn grade(
 ) -> Result<ClassReport, GradeError> {
     let started = Instant::now();
     let rubric = load_rubric(rubric_path)?;
-    let out = &options.out;
     let cache = options.cache.clone().unwrap_or_else(default_cache_dir);
     let (folders, ignored) =
-        student_folders(submissions, &[out, &cache]).map_err(|source| GradeError::Submissions {
+        student_folders(submissions, &[&options.out, &cache]).map_err(|source| GradeError::Submissions {
             path: submissions.to_path_buf(),
             source,
         })?;
+    grade_listed(
+        rubric,
+        started,
+        submissions,
+        folders,
+        ignored,
+        options,
+        diagnose,
+        progress,
+    )
+}
+
+/// One student's folder graded as a class of one named `name`: what a student's self-check and
+/// an autograder grade.
+pub fn grade_one(
+    rubric_path: &Path,
+    folder: &Path,
+    name: &str,
+    options: &GradeOptions,
+    diagnose: Diagnose,
+    progress: &dyn Progress,
+) -> Result<ClassReport, GradeError> {
+    let started = Instant::now();
+    let rubric = load_rubric(rubric_path)?;
+    if !folder.is_dir() {
+        return Err(GradeError::Submissions {
+            path: folder.to_path_buf(),
+            source: std::io::Error::new(std::io::ErrorKind::NotADirectory, "not a folder"),
+        });
+    }
+    let folders = BTreeMap::from([(name.to_owned(), folder.to_path_buf())]);
+    grade_listed(
+        rubric,
+        started,
+        folder,
+        folders,
+        Vec::new(),
+        options,
+        diagnose,
+        progress,
+    )
+}
+
+/// Grades the students of `folders` (name → folder) of the class at `submissions`; `ignored`
+/// are the class folder's other entries, for the report.
+#[allow(clippy::too_many_arguments)]
+fn grade_listed(
+    rubric: Rubric,
+    started: Instant,
+    submissions: &Path,
+    folders: BTreeMap<String, PathBuf>,
+    ignored: Vec<String>,
+    options: &GradeOptions,
+    diagnose: Diagnose,
+    progress: &dyn Progress,
+) -> Result<ClassReport, GradeError> {
+    let out = &options.out;
+    let cache = options.cache.clone().unwrap_or_else(default_cache_dir);
     let names: Vec<String> = folders.keys().cloned().collect();
     let slugs = report::slugs(&names);
     let range = options.shard.range(names.len());

@@ -24,6 +24,7 @@ mod class;
 mod diagnose;
 mod diagnosis;
 mod error;
+mod feedback;
 mod golden;
 mod html;
 mod integrity;
@@ -32,6 +33,7 @@ mod program_run;
 mod report;
 mod resume;
 mod rubric;
+mod rubric_platform;
 mod run_limits;
 mod score;
 mod shard;
@@ -46,13 +48,15 @@ use crate::progress::Progress;
 pub use diagnose::{FAILING_REDUCTION, MISTAKES_DIR, RMSE_REDUCTION, explains, loses_points};
 pub use diagnosis::{Closest, Confidence, Diagnosis, DiagnosisRun, RenderDiagnosis, Residual, UNEXPLAINED};
 pub use error::{GradeError, RubricError};
+pub use feedback::{image_feedback, student_feedback};
 pub use golden::{CacheMode, GoldenRender, Goldens, default_cache_dir, prepare_goldens, write_golden_pictures};
 pub use integrity::{Integrity, LinkPolicy, PUBLISHED_COPY};
 pub use outcome::Outcome;
 pub use program_run::ProgramRun;
-pub use report::{ClassReport, RubricSummary, diagnoses_of, flags, mistakes_of};
+pub use report::{ClassReport, RubricSummary, diagnoses_of, flags, format_points, mistakes_of};
 pub use resume::{RESULT_FILE, StudentRecord};
 pub use rubric::{ImageSpec, Output, RenderOrigin, RenderSource, Rubric, Rule, load_rubric, parse_rubric};
+pub use rubric_platform::{GradescopeSettings, ProgramSection, Visibility};
 pub use score::{Golden, ImageResult, StudentResult, Submission, grade_image, judge};
 pub use shard::{MANIFEST, Manifest, Shard, ShardError};
 pub use similarity::{NEAR_IDENTICAL, SimilarPair};
@@ -106,6 +110,7 @@ pub fn grade_class(
 }
 
 pub use class::grade as grade_class_diagnosing;
+pub use class::grade_one;
 
 /// Combines the report folders of the N shards of a class into `out`, as one run over the whole
 /// class would have written it; refuses shards of different rubrics, golden renders or classes,

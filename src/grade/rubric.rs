@@ -10,6 +10,7 @@ use serde::{Deserialize, Serialize};
 
 use super::error::RubricError;
 use super::integrity::{Integrity, integrity};
+use super::rubric_platform::{GradescopeSettings, ProgramSection, gradescope_section, program_section};
 use super::run_limits::run_limits;
 use crate::case::{self, AssignmentOptions, Case, LoadOptions, MAX_BOUNCES, load_assignment_scene};
 use crate::fault::Fault;
@@ -36,6 +37,11 @@ pub struct Rubric {
     pub mistake_credit: Vec<(Fault, f64)>,
     /// `[limits]`: what `goldray run` allows each command of a student's program.
     pub limits: LimitOverrides,
+    /// `[program]`: the student's program to build and run before grading, if the course
+    /// collects source code.
+    pub program: Option<ProgramSection>,
+    /// `[gradescope]`: who sees which result, and when.
+    pub gradescope: GradescopeSettings,
 }
 
 /// One `[render.NAME]`: a render that one or more images are taken from.
@@ -140,7 +146,17 @@ const DEFAULT_RULE: Rule = Rule {
 };
 const DEFAULT_POINTS: f64 = 1.0;
 
-const TOP_KEYS: &[&str] = &["title", "defaults", "render", "image", "integrity", "mistake", "limits"];
+const TOP_KEYS: &[&str] = &[
+    "title",
+    "defaults",
+    "render",
+    "image",
+    "integrity",
+    "mistake",
+    "limits",
+    "program",
+    "gradescope",
+];
 const RULE_KEYS: &[&str] = &[
     "threshold",
     "pass_fraction",
@@ -213,6 +229,17 @@ pub fn parse_rubric(source: &str, path: &Path) -> Result<Rubric> {
         Some(field) => run_limits(&field.table("[limits]".to_owned())?)?,
         None => LimitOverrides::default(),
     };
+    let program = match top.get("program") {
+        Some(field) => Some(program_section(&field.table("[program]".to_owned())?)?),
+        None => None,
+    };
+    let gradescope = match top.get("gradescope") {
+        Some(field) => {
+            let files: Vec<&str> = images.iter().map(|i| i.file.as_str()).collect();
+            gradescope_section(&field.table("[gradescope]".to_owned())?, &files)?
+        }
+        None => GradescopeSettings::default(),
+    };
     if images.is_empty() {
         return Err(RubricError::Missing {
             file: path.to_path_buf(),
@@ -230,6 +257,8 @@ pub fn parse_rubric(source: &str, path: &Path) -> Result<Rubric> {
         integrity,
         mistake_credit,
         limits,
+        program,
+        gradescope,
     })
 }
 
