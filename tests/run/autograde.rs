@@ -1,9 +1,11 @@
-//! `goldray autograde` with a rubric's `[program]`: on a simulated Gradescope `/autograder` tree,
-//! a C++ submission is built, run and graded, and Gradescope's results say what a student needs;
-//! a submission that does not compile gets the compiler's messages, not seven bare zeros.
+//! `goldray autograde` with a rubric's `[program]`, through the shipped `run_autograder` script on
+//! a simulated Gradescope `/autograder` tree: a C++ submission is built, run and graded, and
+//! Gradescope's results say what a student needs; a submission that does not compile gets the
+//! compiler's messages, not seven bare zeros.
 
 use std::fs;
 use std::path::{Path, PathBuf};
+use std::process::Command;
 
 use serde_json::Value;
 
@@ -30,31 +32,21 @@ fn autograder(dir: &Path, extra: &[(&str, &str)]) -> PathBuf {
     dir.to_path_buf()
 }
 
+/// Gradescope's run: the shipped `run_autograder` script on the tree at `root`.
 fn autograde(root: &Path) -> Value {
-    let paths = [
-        root.join("source/rubric.toml"),
-        root.join("submission"),
-        root.join("results/results.json"),
-    ];
-    let [rubric, submission, results] = paths.each_ref().map(|p| p.to_str().unwrap());
-    let output = goldray(&[
-        "autograde",
-        "--rubric",
-        rubric,
-        "--submission",
-        submission,
-        "--results",
-        results,
-        "--cache",
-        root.join("cache").to_str().unwrap(),
-    ]);
+    let output = Command::new("bash")
+        .arg(project_file("examples/gradescope/run_autograder"))
+        .env("AUTOGRADER_ROOT", root)
+        .env("GOLDRAY", env!("CARGO_BIN_EXE_goldray"))
+        .output()
+        .expect("bash runs");
     assert!(
         output.status.success(),
         "{}\n{}",
         String::from_utf8_lossy(&output.stdout),
         String::from_utf8_lossy(&output.stderr)
     );
-    serde_json::from_slice(&fs::read(&paths[2]).unwrap()).unwrap()
+    serde_json::from_slice(&fs::read(root.join("results/results.json")).unwrap()).unwrap()
 }
 
 #[test]
@@ -76,7 +68,7 @@ fn a_cpp_submission_is_built_run_and_graded_for_gradescope() {
         "--out",
         report.to_str().unwrap(),
         "--cache",
-        root.join("cache").to_str().unwrap(),
+        root.join("source/cache").to_str().unwrap(),
         "--quiet",
         class.to_str().unwrap(),
     ]);
