@@ -408,8 +408,8 @@ fn a_wide_class_table_keeps_names_and_lost_points_on_screen() {
 }
 
 /// A report stays small when students pass: a passing picture that is not identical to the
-/// golden one is kept as a thumbnail with no heatmap; a picture that loses points keeps its full
-/// size and its heatmap.
+/// golden one is kept as a thumbnail with no heatmap, stored once for every student who handed in
+/// the same picture; a picture that loses points keeps its full size and its heatmap.
 #[test]
 fn passing_pictures_are_thumbnails_and_only_lost_points_get_heatmaps() {
     use goldray::film::{Tonemap, color_image};
@@ -432,7 +432,7 @@ fn passing_pictures_are_thumbnails_and_only_lost_points_get_heatmaps() {
             broken.put_pixel(x, y, Rgb([0, 0, 0]));
         }
     }
-    for (name, picture) in [("nearly", &nearly), ("broken", &broken)] {
+    for (name, picture) in [("nearly", &nearly), ("nearly_too", &nearly), ("broken", &broken)] {
         fs::create_dir_all(dir.path().join("subs").join(name)).unwrap();
         picture.save(dir.path().join("subs").join(name).join("c.png")).unwrap();
     }
@@ -448,6 +448,12 @@ fn passing_pictures_are_thumbnails_and_only_lost_points_get_heatmaps() {
     assert!(nearly.diff_image.is_none(), "no heatmap for full points");
     let thumbnail = image::open(out.join(nearly.student_image.as_ref().unwrap())).unwrap();
     assert_eq!((thumbnail.width(), thumbnail.height()), (300, 300));
+    assert_eq!(
+        student(&report, "nearly_too").images[0].student_image,
+        nearly.student_image,
+        "the same passing picture is one file"
+    );
+    assert_eq!(fs::read_dir(out.join("thumbnails")).unwrap().count(), 1);
     let broken = &student(&report, "broken").images[0];
     assert_eq!(broken.outcome, Outcome::Fail);
     let full = image::open(out.join(broken.student_image.as_ref().unwrap())).unwrap();

@@ -251,9 +251,15 @@ pub fn grade_image(
         result.student_image = Some(format!("{GOLDEN_DIR}/{}", spec.file));
     } else if outcome == Outcome::Pass {
         // Full points: a thumbnail shows what was handed in; there is nothing for the student to
-        // find in a full-size copy or a heatmap, and a class that passes keeps a small report.
-        replace_file(&out.join(&copy), &encode_png(&thumbnail(&actual.preview))?)?;
-        result.student_image = Some(copy);
+        // find in a full-size copy or a heatmap. Thumbnails are named by their content and
+        // shared, so that a class handing in the same passing pictures (the published reference
+        // images) stores each once.
+        let bytes = encode_png(&thumbnail(&actual.preview))?;
+        let shared = format!("{THUMBNAILS_DIR}/{}.png", &blake3::hash(&bytes).to_hex()[..32]);
+        if !out.join(&shared).is_file() {
+            replace_file(&out.join(&shared), &bytes)?;
+        }
+        result.student_image = Some(shared);
     } else {
         replace_file(&out.join(&copy), &encode_png(&actual.preview)?)?;
         result.student_image = Some(copy);
@@ -292,6 +298,9 @@ pub fn grade_image(
     result.metrics = Some(metrics);
     Ok(result)
 }
+
+/// The folder of the report holding passing pictures' thumbnails, named by content.
+pub const THUMBNAILS_DIR: &str = "thumbnails";
 
 /// The side of the square a passing picture's thumbnail fits in: the report shows pictures 300
 /// pixels wide.

@@ -236,6 +236,10 @@ pub fn copy_pictures(shard: &ShardOutput, out: &Path) -> Result<(), OutputError>
         &shard.dir.join(super::diagnose::MISTAKES_DIR),
         &out.join(super::diagnose::MISTAKES_DIR),
     )?;
+    copy_tree(
+        &shard.dir.join(super::score::THUMBNAILS_DIR),
+        &out.join(super::score::THUMBNAILS_DIR),
+    )?;
     for slug in &shard.manifest.slugs {
         let student = Path::new("students").join(slug);
         copy_tree(&shard.dir.join(&student), &out.join(&student))?;
