@@ -33,6 +33,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("grade", 12),
     ("tradeoff", 12),
     ("run", 13),
+    ("autograde", 14),
 ];
 
 /// The modules compiled once per precision: inside them, `super::geometry` and the like name a
