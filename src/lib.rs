@@ -23,6 +23,7 @@ pub mod pipeline;
 pub mod precision;
 pub mod progress;
 pub mod provenance;
+pub mod review;
 pub mod run;
 pub mod sandbox;
 pub mod simd;

@@ -32,6 +32,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("pipeline", 11),
     ("grade", 12),
     ("tradeoff", 12),
+    ("review", 12),
     ("run", 13),
     ("autograde", 14),
 ];

@@ -4,6 +4,8 @@
 //! read back, the HTML report opened in headless Chromium, the golden cache, the command line and
 //! the shipped course rubric.
 
+// Shared with tests/diagnose.rs and tests/review.rs; the served page's functions are review's.
+#[allow(dead_code)]
 #[path = "grade/chromium.rs"]
 mod chromium;
 #[path = "grade/class.rs"]

@@ -8,10 +8,12 @@ use std::process::ExitCode;
 
 use goldray::compare::{ToleranceOverrides, compare_files};
 use goldray::provenance::{Provenance, made_differently};
+use goldray::review::write_diff_page;
 
 use super::common::{parse_fraction, parse_threshold};
 
-/// The exit code for a file that cannot be read or decoded (or a `--diff-image` not written).
+/// The exit code for a file that cannot be read or decoded (or a `--diff-image` or `--html` not
+/// written).
 const UNREADABLE: u8 = 4;
 
 /// A threshold left out takes the default for the files' encoding.
@@ -40,11 +42,15 @@ pub struct DiffArgs {
     /// Print the report as JSON.
     #[arg(long)]
     json: bool,
+    /// Write the review page of the two images to this HTML file (pictures, values under the
+    /// cursor, exposure, swipe and flip; everything inside the one file).
+    #[arg(long, value_name = "OUT.html")]
+    html: Option<PathBuf>,
 }
 
 /// Compares, prints the report (text or JSON) on stdout and any error on stderr, and returns the
 /// exit code: 0 pass, 1 warn, 2 fail, 3 size or channel mismatch, 4 unreadable file. The verdict
-/// is printed even when the heatmap cannot be written; the exit code is then 4.
+/// is printed even when the heatmap or the page cannot be written; the exit code is then 4.
 pub fn run(args: DiffArgs) -> ExitCode {
     let overrides = ToleranceOverrides {
         pixel: args.pixel,
@@ -68,6 +74,10 @@ pub fn run(args: DiffArgs) -> ExitCode {
         }
     };
     let heatmap = args.diff_image.as_ref().map(|path| compared.write_heatmap(path));
+    let page = args
+        .html
+        .as_ref()
+        .map(|out| write_diff_page(&args.expected, &args.actual, &overrides, out));
     let comparison = &compared.comparison;
     // Both files were just decoded, so reading their headers again cannot fail in a way that
     // matters: a provenance that cannot be read is reported as none.
@@ -79,6 +89,10 @@ pub fn run(args: DiffArgs) -> ExitCode {
         let line = differently.map(|line| format!("made differently: {line}\n"));
         line.unwrap_or_default() + &comparison.to_string()
     });
+    if let Some(Err(error)) = page {
+        eprintln!("error: {error}");
+        return ExitCode::from(UNREADABLE);
+    }
     match heatmap {
         Some(Err(error)) => {
             eprintln!("error: {error}");

@@ -12,6 +12,7 @@ mod import;
 mod mit6837;
 mod progress;
 mod render;
+mod review;
 mod run;
 mod tradeoff;
 
@@ -48,6 +49,10 @@ enum Command {
     /// reference, and write tradeoff.csv, tradeoff.md and a log-log plot tradeoff.png with the
     /// Pareto front.
     Tradeoff(tradeoff::TradeoffArgs),
+    /// Review the golden suite's pending snapshots (golden/*.snap.new): a local page with the
+    /// pictures and numbers to accept or reject each, or --list, --accept, --reject,
+    /// --accept-all, --static DIR. Accepting writes what `cargo insta accept` writes.
+    Review(review::ReviewArgs),
     /// Run a student's program for every course render of a rubric, each command in a sandbox
     /// with limits, moving the rubric's files into --out with run.json (what each command did).
     Run(run::RunArgs),
@@ -116,6 +121,7 @@ pub fn main() -> ExitCode {
         Command::Run(args) => run::run(args),
         Command::Check(args) => check::run(args),
         Command::Autograde(args) => autograde::run(args),
+        Command::Review(args) => review::run(args),
     };
     match outcome {
         Ok(code) => code,

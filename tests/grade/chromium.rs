@@ -1,5 +1,6 @@
-//! Opening the HTML report in Debian's headless Chromium, from the file system, with every
-//! network feature off: what a TA's browser sees, without a display.
+//! Opening the HTML report in Debian's headless Chromium, from the file system (or the review
+//! page from its local server), with every network feature off: what a TA's browser sees,
+//! without a display.
 
 use std::io::Read;
 use std::path::{Path, PathBuf};
@@ -22,8 +23,12 @@ fn chromium() -> PathBuf {
 
 /// Runs Chromium headless on `page` with `extra` arguments and returns its standard output.
 fn run(page: &Path, extra: &[String]) -> Vec<u8> {
+    run_url(&format!("file://{}", page.canonicalize().unwrap().display()), extra)
+}
+
+/// [`run`] on any address (a page served on 127.0.0.1).
+fn run_url(url: &str, extra: &[String]) -> Vec<u8> {
     let profile = tempfile::tempdir().unwrap();
-    let url = format!("file://{}", page.canonicalize().unwrap().display());
     let mut child = Command::new(chromium())
         .args([
             "--headless",
@@ -38,7 +43,7 @@ fn run(page: &Path, extra: &[String]) -> Vec<u8> {
         ])
         .arg(format!("--user-data-dir={}", profile.path().display()))
         .args(extra)
-        .arg(&url)
+        .arg(url)
         .stdout(Stdio::piped())
         .stderr(Stdio::null())
         .spawn()
@@ -100,4 +105,17 @@ pub fn screenshot(page: &Path, width: u32, height: u32, file: &Path) -> image::R
     image::open(file)
         .unwrap_or_else(|e| panic!("{}: {e}", file.display()))
         .into_rgb8()
+}
+
+/// [`dump_dom_at`] of a page served at `url`.
+pub fn dump_dom_url(url: &str, width: u32, height: u32) -> String {
+    let stdout = run_url(
+        url,
+        &[
+            "--virtual-time-budget=5000".to_owned(),
+            format!("--window-size={width},{height}"),
+            "--dump-dom".to_owned(),
+        ],
+    );
+    String::from_utf8(stdout).expect("the DOM is UTF-8")
 }
