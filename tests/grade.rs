@@ -14,6 +14,8 @@ mod class;
 mod cli;
 #[path = "grade/integrity.rs"]
 mod integrity;
+#[path = "grade/lms.rs"]
+mod lms;
 #[path = "grade/memory.rs"]
 mod memory;
 #[path = "grade/platform.rs"]

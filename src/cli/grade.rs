@@ -18,7 +18,8 @@ pub struct GradeArgs {
     /// The rubric (TOML): expected files, their golden renders, limits and points.
     #[arg(long, required_unless_present = "merge")]
     rubric: Option<PathBuf>,
-    /// A folder holding one folder per student; with --merge, the shards' report folders.
+    /// A folder holding one folder per student, or a Canvas or Moodle download (its .zip, or the
+    /// folder it was extracted to); with --merge, the shards' report folders.
     #[arg(value_name = "SUBMISSIONS")]
     inputs: Vec<PathBuf>,
     /// Folder to write grades.csv, grades.json and index.html (with the pictures) into.

@@ -14,13 +14,13 @@ use super::diagnose::{self, Diagnoser};
 use super::diagnosis::DiagnosisRun;
 use super::error::GradeError;
 use super::golden::{CacheMode, default_cache_dir, prepare_goldens, write_golden_pictures};
+use super::lms::{Class, Layout, Limits, Source, Student as LmsStudent, read_class, stage};
 use super::report::{self, ClassReport, RubricSummary};
 use super::resume::{StudentRecord, read_record, run_fingerprint, student_fingerprint, write_record};
 use super::rubric::{Rubric, load_rubric};
 use super::score::{Golden, StudentResult, Submission, grade_image};
 use super::shard::{Manifest, Shard, copy_pictures, read_shards, write_manifest};
 use super::similarity::{self, similar_pairs};
-use super::submission::student_folders;
 use super::timing::{RunCost, Timings, timed};
 use super::{Diagnose, GradeOptions, html, integrity};
 use crate::film::OutputError;
@@ -44,21 +44,13 @@ pub fn grade(
     let started = Instant::now();
     let rubric = load_rubric(rubric_path)?;
     let cache = options.cache.clone().unwrap_or_else(default_cache_dir);
-    let (folders, ignored) =
-        student_folders(submissions, &[&options.out, &cache]).map_err(|source| GradeError::Submissions {
+    let class = read_class(submissions, &[&options.out, &cache], Limits::default()).map_err(|source| {
+        GradeError::Submissions {
             path: submissions.to_path_buf(),
             source,
-        })?;
-    grade_listed(
-        rubric,
-        started,
-        submissions,
-        folders,
-        ignored,
-        options,
-        diagnose,
-        progress,
-    )
+        }
+    })?;
+    grade_listed(rubric, started, submissions, class, options, diagnose, progress)
 }
 
 /// One student's folder graded as a class of one named `name`: what a student's self-check and
@@ -79,35 +71,49 @@ pub fn grade_one(
             source: std::io::Error::new(std::io::ErrorKind::NotADirectory, "not a folder"),
         });
     }
-    let folders = BTreeMap::from([(name.to_owned(), folder.to_path_buf())]);
-    grade_listed(
-        rubric,
-        started,
-        folder,
-        folders,
-        Vec::new(),
-        options,
-        diagnose,
-        progress,
-    )
+    let class = Class {
+        layout: Layout::Folders,
+        archive: None,
+        students: vec![LmsStudent {
+            name: name.to_owned(),
+            lms: None,
+            source: Source::Folder(folder.to_path_buf()),
+            shown: folder.to_path_buf(),
+            refused: Vec::new(),
+        }],
+        ignored: Vec::new(),
+        refused: Vec::new(),
+    };
+    grade_listed(rubric, started, folder, class, options, diagnose, progress)
 }
 
-/// Grades the students of `folders` (name → folder) of the class at `submissions`; `ignored`
-/// are the class folder's other entries, for the report.
-#[allow(clippy::too_many_arguments)]
+/// Grades the students of `class`, read from `submissions`.
 fn grade_listed(
     rubric: Rubric,
     started: Instant,
     submissions: &Path,
-    folders: BTreeMap<String, PathBuf>,
-    ignored: Vec<String>,
+    class: Class,
     options: &GradeOptions,
     diagnose: Diagnose,
     progress: &dyn Progress,
 ) -> Result<ClassReport, GradeError> {
     let out = &options.out;
     let cache = options.cache.clone().unwrap_or_else(default_cache_dir);
-    let names: Vec<String> = folders.keys().cloned().collect();
+    // A download's students are staged here, one folder each, while they are graded.
+    let staging = if class.students.iter().any(|s| matches!(s.source, Source::Files(_))) {
+        Some(
+            tempfile::Builder::new()
+                .prefix("goldray-grade-")
+                .tempdir()
+                .map_err(|source| GradeError::Submissions {
+                    path: submissions.to_path_buf(),
+                    source,
+                })?,
+        )
+    } else {
+        None
+    };
+    let names: Vec<String> = class.students.iter().map(|s| s.name.clone()).collect();
     let slugs = report::slugs(&names);
     let range = options.shard.range(names.len());
     let cache_mode = if options.shard == Shard::WHOLE {
@@ -133,7 +139,31 @@ fn grade_listed(
         let steps = batch
             .par_iter()
             .map(|&i| {
-                let submission = Submission::new(names[i].clone(), folders[&names[i]].clone(), slugs[i].clone());
+                let student = &class.students[i];
+                let (submission, shown) = match &student.source {
+                    Source::Folder(path) => (Submission::new(names[i].clone(), path.clone(), slugs[i].clone()), None),
+                    Source::Files(items) => {
+                        // Made above whenever a student has files to stage.
+                        let Some(staging) = &staging else {
+                            return Err(GradeError::Submissions {
+                                path: submissions.to_path_buf(),
+                                source: std::io::Error::other("no folder to stage a download's files in"),
+                            });
+                        };
+                        let root = staging.path().join(&slugs[i]);
+                        let mut staged = stage(items, class.archive.as_deref(), &root, Limits::default());
+                        staged.refused.extend(student.refused.iter().cloned());
+                        let submission = Submission::staged(
+                            names[i].clone(),
+                            root.clone(),
+                            slugs[i].clone(),
+                            student.shown.clone(),
+                            student.lms.clone(),
+                            &staged,
+                        );
+                        (submission, Some((root, staged.shown)))
+                    }
+                };
                 let hashing = Instant::now();
                 let inputs = student_fingerprint(&run, &submission, &rubric);
                 let hashing = hashing.elapsed().as_secs_f64();
@@ -142,6 +172,9 @@ fn grade_listed(
                     && record.run == run
                     && record.inputs == inputs
                 {
+                    if let Some((root, _)) = &shown {
+                        let _ = fs::remove_dir_all(root);
+                    }
                     return Ok(Step::Reused(record));
                 }
                 // Pictures an earlier grading of this student left are no longer the student's.
@@ -182,11 +215,13 @@ fn grade_listed(
                     result,
                     inputs,
                     timings,
+                    staged: shown,
                 })
             })
             .collect::<Result<Vec<Step>, GradeError>>()?;
 
         let (mut fresh, mut fresh_inputs, mut fresh_timings) = (Vec::new(), Vec::new(), Vec::new());
+        let mut fresh_staged = Vec::new();
         let mut order = Vec::new();
         for step in steps {
             match step {
@@ -198,8 +233,10 @@ fn grade_listed(
                     result,
                     inputs,
                     timings,
+                    staged,
                 } => {
                     order.push(Ok(fresh.len()));
+                    fresh_staged.push(staged);
                     fresh.push(result);
                     fresh_inputs.push(inputs);
                     fresh_timings.push(timings);
@@ -216,6 +253,13 @@ fn grade_listed(
             let share = diagnosis_started.elapsed().as_secs_f64() / fresh.len() as f64;
             for timings in &mut fresh_timings {
                 timings.diagnosis += share;
+            }
+        }
+        // Diagnosis has read the staged pictures: the report names where they are in the download.
+        for (result, staged) in fresh.iter_mut().zip(fresh_staged) {
+            if let Some((root, shown)) = staged {
+                show_download_files(result, &root, &shown);
+                let _ = fs::remove_dir_all(&root);
             }
         }
         fresh
@@ -258,15 +302,17 @@ fn grade_listed(
         goldray: env!("CARGO_PKG_VERSION"),
         rubric: RubricSummary::of(&rubric),
         submissions: submissions.to_path_buf(),
+        layout: class.layout,
         cache: cache.clone(),
         goldens: goldens.renders,
         diagnosis,
-        ignored,
+        ignored: class.ignored,
+        refused: class.refused,
         similar: Vec::new(),
         students,
         cost,
     };
-    report.similar = find_similar(&report.students);
+    report.similar = find_similar(&report.students, out);
     if options.shard == Shard::WHOLE {
         write_report(&mut report, out, started)?;
     } else {
@@ -281,9 +327,11 @@ fn grade_listed(
         slugs: slice_slugs,
         rubric: report.rubric.clone(),
         submissions: report.submissions.clone(),
+        layout: report.layout,
         cache: report.cache.clone(),
         goldens: report.goldens.clone(),
         ignored: report.ignored.clone(),
+        refused: report.refused.clone(),
         diagnosis: report.diagnosis.clone(),
         cost: report.cost.clone(),
     };
@@ -298,7 +346,24 @@ enum Step {
         result: StudentResult,
         inputs: String,
         timings: Timings,
+        /// For a download's student: the staging folder, and where each staged file came from.
+        staged: Option<(PathBuf, BTreeMap<PathBuf, String>)>,
     },
+}
+
+/// Replaces the staged paths of a download's student's graded files by where the files are in
+/// the download (`class.zip/alice_12_34_a01.png`, or inside the student's own zip), which is what
+/// the report shows and what stays the same from one run to the next.
+fn show_download_files(result: &mut StudentResult, root: &Path, shown: &BTreeMap<PathBuf, String>) {
+    for image in &mut result.images {
+        if let Some(file) = &mut image.graded_file
+            && let Ok(relative) = file.strip_prefix(root)
+        {
+            *file = shown
+                .get(relative)
+                .map_or_else(|| result.folder.join(relative), PathBuf::from);
+        }
+    }
 }
 
 /// Combines the outputs of the N shards of a class (`shards`, in any order) into `out`: the
@@ -326,6 +391,7 @@ pub(super) fn merge(out: &Path, shards: &[PathBuf]) -> Result<ClassReport, Grade
         first.goldens.clone(),
         first.ignored.clone(),
     );
+    let (layout, refused) = (first.layout, first.refused.clone());
     let students: Vec<StudentResult> = shards
         .into_iter()
         .flat_map(|shard| shard.records)
@@ -335,11 +401,13 @@ pub(super) fn merge(out: &Path, shards: &[PathBuf]) -> Result<ClassReport, Grade
         goldray: env!("CARGO_PKG_VERSION"),
         rubric,
         submissions,
+        layout,
         cache,
         goldens,
         diagnosis,
         ignored,
-        similar: find_similar(&students),
+        refused,
+        similar: find_similar(&students, out),
         students,
         cost,
     };
@@ -361,21 +429,43 @@ fn write_report(report: &mut ClassReport, out: &Path, started: Instant) -> Resul
     Ok(())
 }
 
-/// Pairs of students who handed in the same (or nearly the same failing) picture.
-fn find_similar(students: &[StudentResult]) -> Vec<similarity::SimilarPair> {
+/// Pairs of students who handed in the same (or nearly the same failing) picture. A picture that
+/// lost points is compared in full from the report's copy of it (in `out`), which is there for
+/// every such picture however the class was read: a download's staged files are gone by now, and
+/// shards merged on another machine never had the submissions.
+fn find_similar(students: &[StudentResult], out: &Path) -> Vec<similarity::SimilarPair> {
+    let copies: Vec<Vec<Option<PathBuf>>> = students
+        .iter()
+        .map(|student| {
+            student
+                .images
+                .iter()
+                .map(|image| match &image.student_image {
+                    Some(copy) if copy.starts_with("students/") => Some(out.join(copy)),
+                    _ => image.graded_file.clone(),
+                })
+                .collect()
+        })
+        .collect();
     similar_pairs(
         &students
             .iter()
-            .flat_map(|student| {
-                student.images.iter().enumerate().filter_map(|(order, image)| {
-                    Some(similarity::Entry {
-                        student: &student.name,
-                        file: &image.file,
-                        order,
-                        path: image.graded_file.as_deref()?,
-                        fingerprint: image.fingerprint.as_ref()?,
+            .zip(&copies)
+            .flat_map(|(student, copies)| {
+                student
+                    .images
+                    .iter()
+                    .zip(copies)
+                    .enumerate()
+                    .filter_map(|(order, (image, copy))| {
+                        Some(similarity::Entry {
+                            student: &student.name,
+                            file: &image.file,
+                            order,
+                            path: copy.as_deref()?,
+                            fingerprint: image.fingerprint.as_ref()?,
+                        })
                     })
-                })
             })
             .collect::<Vec<_>>(),
     )

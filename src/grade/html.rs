@@ -9,6 +9,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
+mod download;
 mod mistakes;
 mod program;
 
@@ -103,10 +104,11 @@ fn page(title: &str, body: &str) -> String {
     format!(
         "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n\
          <meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n\
-         <title>{}</title>\n<style>{STYLE}{}{}</style>\n</head>\n<body>\n{body}<script>{SCRIPT}</script>\n</body>\n</html>\n",
+         <title>{}</title>\n<style>{STYLE}{}{}{}</style>\n</head>\n<body>\n{body}<script>{SCRIPT}</script>\n</body>\n</html>\n",
         escape(title),
         mistakes::STYLE,
-        program::STYLE
+        program::STYLE,
+        download::STYLE
     )
 }
 
@@ -125,6 +127,7 @@ fn index(report: &ClassReport) -> String {
         escape(&rubric.path.display().to_string()),
         report.goldray,
     );
+    download::source(&mut body, report);
     mistakes::histogram(&mut body, report);
     // The student column stays put while the per-image cells scroll; the summary before them
     // names the images that lost points, so a wide rubric never hides a failure off screen.
@@ -143,9 +146,10 @@ fn index(report: &ClassReport) -> String {
     for student in &report.students {
         let _ = write!(
             body,
-            "<tr><td class=\"name\"><a href=\"{}\">{}</a></td><td>{} / {max}</td><td class=\"lost\">{}</td>",
+            "<tr><td class=\"name\"><a href=\"{}\">{}</a>{}</td><td>{} / {max}</td><td class=\"lost\">{}</td>",
             escape(&student.page),
             escape(&student.name),
+            download::identity(student),
             format_points(student.total),
             lost_points(student)
         );
@@ -307,8 +311,9 @@ Hover a cell for the reason; click it for the pictures.</p>\n";
 fn student_page(report: &ClassReport, student: &StudentResult) -> String {
     let name = escape(&student.name);
     let mut body = format!(
-        "<p><a href=\"../index.html\">← all students</a></p>\n<h1>{name}</h1>\n\
+        "<p><a href=\"../index.html\">← all students</a></p>\n<h1>{name}{}</h1>\n\
          <p>{} / {} points · folder <code>{}</code> · {}</p>\n",
+        download::identity(student),
         format_points(student.total),
         format_points(student.max_points),
         escape(&student.folder.display().to_string()),
@@ -317,6 +322,7 @@ fn student_page(report: &ClassReport, student: &StudentResult) -> String {
     for flag in flags(student) {
         let _ = writeln!(body, "<p><span class=\"flag\">{}</span></p>", escape(&flag));
     }
+    download::refused(&mut body, student);
     // Every image at a glance, in rubric order; each chip jumps to its section.
     body.push_str("<nav class=\"chips\">");
     for result in &student.images {

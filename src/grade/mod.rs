@@ -28,6 +28,7 @@ mod feedback;
 mod golden;
 mod html;
 mod integrity;
+mod lms;
 mod outcome;
 mod program_run;
 mod report;
@@ -51,6 +52,7 @@ pub use error::{GradeError, RubricError};
 pub use feedback::{image_feedback, student_feedback};
 pub use golden::{CacheMode, GoldenRender, Goldens, default_cache_dir, prepare_goldens, write_golden_pictures};
 pub use integrity::{Integrity, LinkPolicy, PUBLISHED_COPY};
+pub use lms::{Layout, LmsId, Refusal};
 pub use outcome::Outcome;
 pub use program_run::ProgramRun;
 pub use report::{ClassReport, RubricSummary, diagnoses_of, flags, format_points, mistakes_of};
@@ -170,8 +172,14 @@ pub fn summary(report: &ClassReport, out: &Path) -> String {
             run.seconds
         )
     });
+    let refused: usize = report.refused.len() + report.students.iter().map(|s| s.refused.len()).sum::<usize>();
+    let layout = match (report.layout, refused) {
+        (Layout::Folders, 0) => String::new(),
+        (layout, 0) => format!(" from {}", layout.describe()),
+        (layout, n) => format!(" from {} ({n} files refused: see the report)", layout.describe()),
+    };
     format!(
-        "graded {} students on {} images ({}); {} golden renders ({rendered} rendered, {} cached in {}){diagnosis}\n{}\nreport: {}",
+        "graded {} students{layout} on {} images ({}); {} golden renders ({rendered} rendered, {} cached in {}){diagnosis}\n{}\nreport: {}",
         report.students.len(),
         report.rubric.images.len(),
         if counts.is_empty() {

@@ -7,7 +7,9 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize, Serializer};
 
 use super::diagnosis::DiagnosisRun;
+use super::diagnosis::UNEXPLAINED;
 use super::golden::GoldenRender;
+use super::lms::{Layout, Refusal, canvas, moodle};
 use super::rubric::{ImageSpec, Rubric};
 use super::score::StudentResult;
 use super::similarity::SimilarPair;
@@ -22,6 +24,8 @@ pub struct ClassReport {
     pub goldray: &'static str,
     pub rubric: RubricSummary,
     pub submissions: PathBuf,
+    /// How the submissions were laid out: plain folders, or a Canvas or Moodle download.
+    pub layout: Layout,
     /// Where the golden renders were cached.
     pub cache: PathBuf,
     /// Each render's name and cache key (what it cost goes to `run.json`).
@@ -33,6 +37,9 @@ pub struct ClassReport {
     pub diagnosis: Option<DiagnosisRun>,
     /// Entries of the submissions folder that are not student folders (loose files), by name.
     pub ignored: Vec<String>,
+    /// Entries of a download that were refused and belong to no student, each with why.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub refused: Vec<Refusal>,
     /// By folder name.
     pub students: Vec<StudentResult>,
     /// Pairs of students who handed in the same picture, or nearly the same failing one.
@@ -87,6 +94,9 @@ pub struct RubricSummary {
     /// The rubric's credit per diagnosed mistake, by catalogue id (absent: none).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub mistake_credit: BTreeMap<String, f64>,
+    /// The assignment's column in Canvas's gradebook (`[lms] assignment`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lms_assignment: Option<String>,
 }
 
 impl RubricSummary {
@@ -101,13 +111,24 @@ impl RubricSummary {
                 .iter()
                 .map(|(f, c)| (f.name().to_owned(), *c))
                 .collect(),
+            lms_assignment: rubric.lms_assignment.clone(),
         }
     }
 }
 
-/// Writes `grades.csv` and `grades.json` into `out`.
+/// Writes `grades.csv` and `grades.json` into `out`, and for a download whose students carry
+/// their platform's ids, the grades in the form that platform imports.
 pub fn write_data(report: &ClassReport, out: &Path) -> Result<(), OutputError> {
     write_file_atomic(&out.join("grades.csv"), grades_csv(report).as_bytes())?;
+    for (platform, file) in [(Layout::Moodle, MOODLE_CSV), (Layout::Canvas, CANVAS_CSV)] {
+        match lms_csv(report, platform) {
+            Some(csv) => write_file_atomic(&out.join(file), csv.as_bytes())?,
+            // One left by an earlier run over another class is not this class's.
+            None => {
+                let _ = std::fs::remove_file(out.join(file));
+            }
+        }
+    }
     // Serialising plain data to a string cannot fail; infinite numbers (the PSNR of identical
     // pictures) become null.
     let json = serde_json::to_string_pretty(report).unwrap_or_else(|e| format!("{{\"error\": {:?}}}", e.to_string()));
@@ -139,6 +160,85 @@ pub fn grades_csv(report: &ClassReport) -> String {
         csv.push_str("\r\n");
     }
     csv
+}
+
+/// Moodle's offline grading worksheet, filled.
+pub const MOODLE_CSV: &str = "grades-moodle.csv";
+/// Canvas's gradebook import, filled.
+pub const CANVAS_CSV: &str = "grades-canvas.csv";
+
+/// The grades as `platform` imports them, when the class's students carry its ids: Moodle's
+/// worksheet with the per-image verdicts and the diagnoses as feedback, or Canvas's gradebook
+/// columns with the rubric's `[lms] assignment` (else its title) as the assignment's.
+pub fn lms_csv(report: &ClassReport, platform: Layout) -> Option<String> {
+    let students: Vec<(&StudentResult, &str)> = report
+        .students
+        .iter()
+        .filter_map(|s| {
+            s.lms
+                .as_ref()
+                .filter(|l| l.platform == platform)
+                .map(|l| (s, l.id.as_str()))
+        })
+        .collect();
+    if students.is_empty() {
+        return None;
+    }
+    let maximum = format_points(report.rubric.max_points);
+    let mut rows = match platform {
+        Layout::Canvas => {
+            let assignment = report.rubric.lms_assignment.as_deref().unwrap_or(&report.rubric.title);
+            vec![canvas::header(assignment), canvas::points_possible(&maximum)]
+        }
+        _ => vec![moodle::HEADER.map(str::to_owned).to_vec()],
+    };
+    for (student, id) in students {
+        let total = format_points(student.total);
+        rows.push(match platform {
+            Layout::Canvas => canvas::row(&student.name, id, &total),
+            _ => moodle::row(id, &student.name, &total, &maximum, &feedback(student)),
+        });
+    }
+    let mut csv = String::new();
+    for row in rows {
+        csv.push_str(&row.iter().map(|cell| csv_field(cell)).collect::<Vec<_>>().join(","));
+        csv.push_str("\r\n");
+    }
+    Some(csv)
+}
+
+/// What a student reads as feedback: a line per image with its verdict, points and why, and
+/// for an image a known mistake explains, the mistake and where to look for it.
+pub fn feedback(student: &StudentResult) -> String {
+    let mut lines = Vec::new();
+    for image in &student.images {
+        let mut line = format!(
+            "{}: {}, {} of {} points",
+            image.file,
+            image.outcome.word(),
+            format_points(image.points),
+            format_points(image.max_points)
+        );
+        if image.points < image.max_points && !image.explanation.is_empty() {
+            line.push_str(&format!(" ({})", image.explanation));
+        }
+        if let Some(diagnosis) = image.diagnosis.as_ref().filter(|d| d.id != UNEXPLAINED) {
+            line.push_str(&format!(
+                ". Likely mistake: {}: {}",
+                diagnosis.id, diagnosis.explanation
+            ));
+            if !diagnosis.hints.is_empty() {
+                line.push_str(&format!(" Where to look: {}", diagnosis.hints.join("; ")));
+            }
+        }
+        lines.push(line);
+    }
+    lines.push(format!(
+        "Total: {} of {} points",
+        format_points(student.total),
+        format_points(student.max_points)
+    ));
+    lines.join("\n")
 }
 
 /// Each flag of a student's images, as `FILE: flag`.

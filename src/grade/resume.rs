@@ -9,7 +9,7 @@
 //! output and points, the mistake credits, the integrity settings and the published images'
 //! pixels), the golden renders' cache keys (which name the scene, its assets and the goldray
 //! executable) and whether diagnosis ran. A student's adds the student's name and report name,
-//! the folder's file list, and for each expected file where it was found, where a link points
+//! where the files are shown and the platform's id, the folder's file list and refused files, and for each expected file where it was found, where a link points
 //! and every byte of it.
 
 use std::collections::HashMap;
@@ -117,7 +117,12 @@ pub fn student_fingerprint(run: &str, submission: &Submission, rubric: &Rubric) 
     run.hash(&mut hasher);
     submission.name.hash(&mut hasher);
     submission.slug.hash(&mut hasher);
-    submission.path.hash(&mut hasher);
+    // Where the files are shown, not where they are read: a download's student is staged in
+    // another temporary folder each run.
+    submission.shown.hash(&mut hasher);
+    serde_json::to_string(&submission.lms)
+        .unwrap_or_default()
+        .hash(&mut hasher);
     submission.hash_inputs(rubric.images.iter().map(|i| i.file.as_str()), &mut hasher);
     format!("{:016x}", hasher.finish())
 }

@@ -42,6 +42,9 @@ pub struct Rubric {
     pub program: Option<ProgramSection>,
     /// `[gradescope]`: who sees which result, and when.
     pub gradescope: GradescopeSettings,
+    /// `[lms] assignment`: the assignment's column in Canvas's gradebook (`Assignment 4 (1234)`),
+    /// which `grades-canvas.csv` fills.
+    pub lms_assignment: Option<String>,
 }
 
 /// One `[render.NAME]`: a render that one or more images are taken from.
@@ -156,7 +159,9 @@ const TOP_KEYS: &[&str] = &[
     "limits",
     "program",
     "gradescope",
+    "lms",
 ];
+const LMS_KEYS: &[&str] = &["assignment"];
 const RULE_KEYS: &[&str] = &[
     "threshold",
     "pass_fraction",
@@ -240,6 +245,10 @@ pub fn parse_rubric(source: &str, path: &Path) -> Result<Rubric> {
         }
         None => GradescopeSettings::default(),
     };
+    let lms_assignment = match top.get("lms") {
+        Some(field) => lms_assignment(&field.table("[lms]".to_owned())?)?,
+        None => None,
+    };
     if images.is_empty() {
         return Err(RubricError::Missing {
             file: path.to_path_buf(),
@@ -259,7 +268,18 @@ pub fn parse_rubric(source: &str, path: &Path) -> Result<Rubric> {
         limits,
         program,
         gradescope,
+        lms_assignment,
     })
+}
+
+/// `[lms] assignment = "Assignment 4 (1234)"`: one line of text, as a CSV header cell.
+fn lms_assignment(table: &Table) -> Result<Option<String>> {
+    table.check_keys(LMS_KEYS)?;
+    Ok(table.read("assignment", None, |f| match f.string()? {
+        name if name.trim().is_empty() => Err(f.invalid("the assignment's name is empty")),
+        name if name.contains(['\n', '\r']) => Err(f.invalid("the assignment's name must be one line")),
+        name => Ok(Some(name.to_owned())),
+    })?)
 }
 
 /// `[mistake."no-shadows"] credit = 0.5`, one table per catalogue id.

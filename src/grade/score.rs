@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 use super::diagnosis::Diagnosis;
 use super::golden::GOLDEN_DIR;
 use super::integrity::{Integrity, PUBLISHED_COPY, pixel_hash, refuse_link};
+use super::lms::{LmsId, Staged};
 use super::outcome::Outcome;
 use super::program_run::{ProgramRun, absent_verdict, delivered_note, read_run_record};
 use super::rubric::{ImageSpec, Rule};
@@ -61,9 +62,17 @@ pub struct ImageResult {
 /// All of one student's results, in rubric order.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct StudentResult {
-    /// The folder's name (lossily decoded if it is not UTF-8).
+    /// The folder's name (lossily decoded if it is not UTF-8), or the name the learning platform
+    /// gives the student.
     pub name: String,
+    /// Who the student is on the learning platform whose download was graded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lms: Option<LmsId>,
+    /// Where the student's files are: their folder, or in a download, where their files were.
     pub folder: PathBuf,
+    /// The student's files that were refused (hostile archive entries), each with why.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub refused: Vec<String>,
     /// The student's page, relative to the report directory.
     pub page: String,
     pub total: f64,
@@ -75,9 +84,15 @@ pub struct StudentResult {
 /// page go under (see `report::slugs`).
 pub struct Submission {
     pub name: String,
+    /// Where the files are read: the student's folder, or their files staged out of a download.
     pub path: PathBuf,
+    /// Where the report says the files are (the folder, or where they are in the download).
+    pub shown: PathBuf,
     pub slug: String,
+    pub lms: Option<LmsId>,
     files: Folder,
+    /// Notes on the files that were refused.
+    refused: Vec<String>,
     /// What `goldray run` recorded when it made this folder's pictures.
     pub run: Option<RunRecord>,
 }
@@ -88,11 +103,36 @@ impl Submission {
         let run = read_run_record(&path);
         Submission {
             name,
+            shown: path.clone(),
             path,
             slug,
+            lms: None,
             files,
+            refused: Vec::new(),
             run,
         }
+    }
+
+    /// A download's student whose files were staged at `path`: the report shows `shown`, names
+    /// their platform id, and gives the refused files their verdicts.
+    pub fn staged(
+        name: String,
+        path: PathBuf,
+        slug: String,
+        shown: PathBuf,
+        lms: Option<LmsId>,
+        staged: &Staged,
+    ) -> Submission {
+        let mut submission = Submission::new(name, path, slug);
+        submission.shown = shown;
+        submission.lms = lms;
+        submission.files.refused = staged
+            .refused
+            .iter()
+            .map(|(path, refusal)| (path.clone(), refusal.outcome.clone()))
+            .collect();
+        submission.refused = staged.refused.iter().map(|(_, refusal)| refusal.note()).collect();
+        submission
     }
 
     /// Feeds `hasher` what grading the expected files `names` reads of this submission.
@@ -113,7 +153,9 @@ impl StudentResult {
     pub fn new(submission: &Submission, images: Vec<ImageResult>) -> StudentResult {
         StudentResult {
             name: submission.name.clone(),
-            folder: submission.path.clone(),
+            lms: submission.lms.clone(),
+            folder: submission.shown.clone(),
+            refused: submission.refused.clone(),
             page: format!("{}.html", submission.dir()),
             total: images.iter().map(|i| i.points).sum(),
             max_points: images.iter().map(|i| i.max_points).sum(),
@@ -175,6 +217,9 @@ pub fn grade_image(
     let located = match (&folder.error, folder.find(&spec.file)) {
         (Some(reason), _) => return Ok(refused(result, Outcome::Unreadable { reason: reason.clone() })),
         (None, None) => {
+            if let Some(outcome) = folder.refusal(&spec.file) {
+                return Ok(refused(result, outcome.clone()));
+            }
             let why = submission.run.as_ref().and_then(|run| absent_verdict(run, &spec.file));
             return Ok(match why {
                 Some((outcome, explanation, program)) => {

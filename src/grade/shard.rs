@@ -20,6 +20,7 @@ use serde::{Deserialize, Serialize};
 use super::diagnosis::DiagnosisRun;
 use super::error::GradeError;
 use super::golden::GoldenRender;
+use super::lms::{Layout, Refusal};
 use super::report::RubricSummary;
 use super::resume::{StudentRecord, read_record};
 use super::timing::RunCost;
@@ -98,9 +99,11 @@ pub struct Manifest {
     pub slugs: Vec<String>,
     pub rubric: RubricSummary,
     pub submissions: PathBuf,
+    pub layout: Layout,
     pub cache: PathBuf,
     pub goldens: Vec<GoldenRender>,
     pub ignored: Vec<String>,
+    pub refused: Vec<Refusal>,
     /// `None` when the run did not diagnose.
     pub diagnosis: Option<DiagnosisRun>,
     pub cost: RunCost,

@@ -41,6 +41,9 @@ pub struct Folder {
     files: Vec<PathBuf>,
     /// Why the folder itself could not be listed.
     pub error: Option<String>,
+    /// Files of the submission that were refused before they reached the folder (entries of a
+    /// hostile archive), by the name they would have had, with their verdict.
+    pub refused: Vec<(PathBuf, Outcome)>,
 }
 
 /// A file to grade, and how it was found when not exactly where expected.
@@ -55,6 +58,7 @@ impl Folder {
             root: root.to_path_buf(),
             files: Vec::new(),
             error: None,
+            refused: Vec::new(),
         };
         if let Err(e) = fs::read_dir(root) {
             folder.error = Some(format!("cannot list the folder: {e}"));
@@ -116,19 +120,48 @@ impl Folder {
 }
 
 impl Folder {
+    /// The verdict of a refused file named `name` (ignoring case, shallowest first), when the
+    /// folder has no such file: an archive's link named `a01.png` is `linked`, not `missing`.
+    pub fn refusal(&self, name: &str) -> Option<&Outcome> {
+        let mut named: Vec<&(PathBuf, Outcome)> = self
+            .refused
+            .iter()
+            .filter(|(path, _)| {
+                path.file_name()
+                    .is_some_and(|n| n.to_string_lossy().eq_ignore_ascii_case(name))
+            })
+            .collect();
+        named.sort_by_key(|(path, _)| path.components().count());
+        named.first().map(|(_, outcome)| outcome)
+    }
+
     /// Feeds `hasher` everything grading `names` reads from this folder: the listing (which
-    /// decides where each file is found), and for each expected file its path, where a link
-    /// points and its bytes. Files that cannot be read are hashed as such.
+    /// decides where each file is found) and the refused files, and for each expected file its
+    /// path in the folder, where a link points and its bytes. Files that cannot be read are
+    /// hashed as such. Paths are hashed relative to the folder, so that a download staged in
+    /// another temporary folder each run hashes the same.
     pub fn hash_inputs<'a>(&self, names: impl Iterator<Item = &'a str>, hasher: &mut impl Hasher) {
         self.error.hash(hasher);
         self.files.hash(hasher);
+        serde_json::to_string(&self.refused).unwrap_or_default().hash(hasher);
+        let root = fs::canonicalize(&self.root).ok();
         for name in names {
             let Some(located) = self.find(name) else {
                 continue;
             };
-            located.path.hash(hasher);
+            located
+                .path
+                .strip_prefix(&self.root)
+                .unwrap_or(&located.path)
+                .hash(hasher);
             fs::read_link(&located.path).ok().hash(hasher);
-            fs::canonicalize(&located.path).ok().hash(hasher);
+            fs::canonicalize(&located.path)
+                .ok()
+                .map(|target| match &root {
+                    Some(root) => target.strip_prefix(root).map(Path::to_path_buf).unwrap_or(target),
+                    None => target,
+                })
+                .hash(hasher);
             let bytes = fs::metadata(&located.path)
                 .ok()
                 .filter(|m| m.is_file() && m.len() <= MAX_FILE_BYTES)

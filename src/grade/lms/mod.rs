@@ -1,0 +1,407 @@
+//! Submissions as learning platforms hand them over: a folder of student folders, or a Canvas or
+//! Moodle download, zipped or extracted.
+//!
+//! [`read_class`] finds the students and their files without extracting anything: a plain
+//! folder's students are its folders, as ever; a download's students are found by the names the
+//! platform gives (see `canvas` and `moodle`), each with their name and id on the platform. A
+//! student whose files are not a folder of their own is [`stage`]d just before grading: their
+//! files copied (out of the archive, with its checks) into a folder of a temporary directory,
+//! their own zips expanded beside them, and the report told where each file came from.
+
+mod archive;
+pub mod canvas;
+pub mod moodle;
+mod stage;
+
+use std::collections::BTreeMap;
+use std::fs;
+use std::io;
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+pub use archive::{Limits, Refusal};
+pub use stage::{Staged, stage};
+
+/// How the submissions were laid out.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Layout {
+    /// One folder per student, named as the student appears.
+    Folders,
+    /// Canvas's "Download Submissions": flat files `name_[LATE_]userid_submissionid_original`.
+    Canvas,
+    /// Moodle's "Download all submissions": a folder per student, `Full Name_ID_assignsubmission_file_`.
+    Moodle,
+}
+
+impl Layout {
+    pub fn describe(self) -> &'static str {
+        match self {
+            Layout::Folders => "one folder per student",
+            Layout::Canvas => "a Canvas download",
+            Layout::Moodle => "a Moodle download",
+        }
+    }
+}
+
+/// Who a student is on the learning platform.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct LmsId {
+    pub platform: Layout,
+    /// Canvas's user id, or Moodle's participant id.
+    pub id: String,
+    /// Canvas marked the submission late.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub late: bool,
+}
+
+/// Where a student's files come from.
+#[derive(Clone, Debug)]
+pub enum Source {
+    /// A folder of their own, read where it is (today's layout).
+    Folder(PathBuf),
+    /// Files to be staged, each under the name it is graded by.
+    Files(Vec<Item>),
+}
+
+/// One file of a student to be staged.
+#[derive(Clone, Debug)]
+pub struct Item {
+    /// Where it goes in the student's staged folder: the original name restored.
+    pub path: PathBuf,
+    pub origin: Origin,
+    /// Where it was found, for the report (`class.zip/alice_12_34_a01.png`).
+    pub shown: String,
+}
+
+#[derive(Clone, Debug)]
+pub enum Origin {
+    /// The entry of that index of the class archive.
+    Entry(usize),
+    /// A file of an extracted download.
+    File(PathBuf),
+}
+
+/// One student as the platform names them.
+#[derive(Clone, Debug)]
+pub struct Student {
+    /// As the report names them: the folder's name, Canvas's `smithjohn`, Moodle's full name;
+    /// with the id added when two students share a name.
+    pub name: String,
+    pub lms: Option<LmsId>,
+    pub source: Source,
+    /// Where the student's files are, for the report.
+    pub shown: PathBuf,
+    /// Their archive entries that were refused, under the names they would have had.
+    pub refused: Vec<(PathBuf, Refusal)>,
+}
+
+/// A class as read from its submissions.
+pub struct Class {
+    pub layout: Layout,
+    /// The class archive, when the submissions are a zip.
+    pub archive: Option<PathBuf>,
+    /// Sorted by name: shards cut this list.
+    pub students: Vec<Student>,
+    /// Entries that are not students' (loose files), by name.
+    pub ignored: Vec<String>,
+    /// Entries of the class archive that were refused and belong to no student.
+    pub refused: Vec<Refusal>,
+}
+
+/// Whether `path` is read as an archive rather than a folder.
+pub fn is_archive(path: &Path) -> bool {
+    path.is_file() && path.extension().is_some_and(|e| e.eq_ignore_ascii_case("zip"))
+}
+
+/// The class in `submissions` (a folder or a `.zip`), skipping hidden entries, `__MACOSX` and
+/// the folders of `own` (the report, the cache).
+pub fn read_class(submissions: &Path, own: &[&PathBuf], limits: Limits) -> io::Result<Class> {
+    if is_archive(submissions) {
+        return read_archive(submissions, limits);
+    }
+    let own: Vec<PathBuf> = own.iter().filter_map(|p| p.canonicalize().ok()).collect();
+    let mut entries: Vec<(String, PathBuf, bool)> = Vec::new();
+    for entry in fs::read_dir(submissions)? {
+        let entry = entry?;
+        let name = entry.file_name().to_string_lossy().into_owned();
+        let path = entry.path();
+        if skipped(&name) || path.canonicalize().is_ok_and(|p| own.contains(&p)) {
+            continue;
+        }
+        let is_dir = path.is_dir();
+        entries.push((name, path, is_dir));
+    }
+    entries.sort();
+    let names: Vec<(String, bool)> = entries.iter().map(|(n, _, d)| (n.clone(), *d)).collect();
+    let layout = detect(&names);
+    let mut found = Found::default();
+    for (name, path, is_dir) in entries {
+        if layout == Layout::Folders && is_dir {
+            found.folder(&name, &path);
+            continue;
+        }
+        let mut files = Vec::new();
+        if is_dir {
+            walk(&path, Path::new(""), 0, &mut files);
+        } else {
+            files.push(PathBuf::new());
+        }
+        let mut placed = false;
+        for relative in files {
+            let within = Path::new(&name).join(&relative);
+            let within = within.to_string_lossy();
+            if let Some(place) = placement(layout, within.trim_end_matches('/'), submissions) {
+                let item = Item {
+                    path: PathBuf::from(place.relative),
+                    origin: Origin::File(path.join(&relative)),
+                    shown: path.join(&relative).display().to_string(),
+                };
+                found.add(&place, item);
+                placed = true;
+            }
+        }
+        if !placed {
+            found.ignored.push(name);
+        }
+    }
+    Ok(found.class(layout, None, Vec::new()))
+}
+
+/// Hidden entries and macOS archive litter.
+fn skipped(name: &str) -> bool {
+    name.starts_with('.') || name == "__MACOSX"
+}
+
+/// Which layout names the most of the top-level entries (name, is a folder): Moodle's folders
+/// or prefixed files, Canvas's files, or else plain folders.
+fn detect(top: &[(String, bool)]) -> Layout {
+    let moodle = top.iter().filter(|(n, _)| moodle::parse(n).is_some()).count();
+    let canvas = top.iter().filter(|(n, d)| !d && canvas::parse(n).is_some()).count();
+    match (moodle, canvas) {
+        (0, 0) => Layout::Folders,
+        (m, c) if m >= c => Layout::Moodle,
+        _ => Layout::Canvas,
+    }
+}
+
+/// A Canvas student's files have no folder: the report shows the pattern they share.
+fn canvas_folder(root: &Path, file: &canvas::CanvasFile) -> PathBuf {
+    let late = if file.late { "LATE_" } else { "" };
+    root.join(format!("{}_{late}{}_*", file.name, file.user_id))
+}
+
+/// The files under `dir`, relative to it, at most three levels down, links included as files
+/// (staging refuses them).
+fn walk(root: &Path, relative: &Path, depth: usize, files: &mut Vec<PathBuf>) {
+    let Ok(entries) = fs::read_dir(root.join(relative)) else {
+        return;
+    };
+    let mut entries: Vec<_> = entries.flatten().collect();
+    entries.sort_by_key(|e| e.file_name());
+    for entry in entries {
+        let name = entry.file_name();
+        if skipped(&name.to_string_lossy()) {
+            continue;
+        }
+        let path = relative.join(&name);
+        match entry.file_type() {
+            Ok(kind) if kind.is_dir() => {
+                if depth + 1 < 3 {
+                    walk(root, &path, depth + 1, files);
+                }
+            }
+            Ok(_) => files.push(path),
+            Err(_) => {}
+        }
+    }
+}
+
+/// A class archive: its entries sorted into students by the layout their names follow.
+fn read_archive(path: &Path, limits: Limits) -> io::Result<Class> {
+    let archive = archive::Archive::open(path, limits)
+        .map_err(|reason| io::Error::new(io::ErrorKind::InvalidData, format!("{}: {reason}", path.display())))?;
+    let shown = |name: &str| format!("{}/{name}", path.display());
+    let mut top: Vec<(String, bool)> = archive
+        .entries
+        .iter()
+        .map(|e| {
+            let mut parts = e.name.splitn(2, '/');
+            let first = parts.next().unwrap_or_default().to_owned();
+            (first, parts.next().is_some())
+        })
+        .filter(|(first, _)| !skipped(first))
+        .collect();
+    top.sort();
+    top.dedup();
+    let layout = detect(&top);
+    let mut found = Found::default();
+    for entry in &archive.entries {
+        match placement(layout, &entry.name, path) {
+            Some(place) => {
+                let item = Item {
+                    path: PathBuf::from(place.relative),
+                    origin: Origin::Entry(entry.index),
+                    shown: shown(&entry.name),
+                };
+                found.add(&place, item);
+            }
+            None if !skipped(entry.name.split('/').next().unwrap_or_default()) => {
+                found.ignored.push(entry.name.clone())
+            }
+            None => {}
+        }
+    }
+    let mut refused = Vec::new();
+    for refusal in &archive.refused {
+        match placement(layout, &refusal.entry, path) {
+            Some(place) => found.refuse(&place, refusal.clone()),
+            None => refused.push(refusal.clone()),
+        }
+    }
+    Ok(found.class(layout, Some(path.to_path_buf()), refused))
+}
+
+/// Whose file an archive entry is, under what name.
+struct Placement<'a> {
+    name: &'a str,
+    platform: Layout,
+    id: &'a str,
+    late: bool,
+    /// Where the student's files are, for the report.
+    folder: PathBuf,
+    /// The file's name in the student's folder.
+    relative: &'a str,
+}
+
+/// The student an entry named `name` of the archive at `archive` belongs to in `layout`.
+fn placement<'a>(layout: Layout, name: &'a str, archive: &Path) -> Option<Placement<'a>> {
+    let (first, rest) = match name.split_once('/') {
+        Some((first, rest)) => (first, Some(rest)),
+        None => (name, None),
+    };
+    if skipped(first) {
+        return None;
+    }
+    match (layout, rest) {
+        (Layout::Folders, Some(rest)) => Some(Placement {
+            name: first,
+            platform: Layout::Folders,
+            id: "",
+            late: false,
+            folder: archive.join(first),
+            relative: rest,
+        }),
+        (Layout::Moodle, _) => {
+            let m = moodle::parse(first)?;
+            let relative = rest.unwrap_or(m.rest);
+            let folder = &first[..first.len() - m.rest.len()];
+            (!relative.is_empty()).then(|| Placement {
+                name: m.full_name,
+                platform: Layout::Moodle,
+                id: m.participant,
+                late: false,
+                folder: archive.join(folder),
+                relative,
+            })
+        }
+        (Layout::Canvas, None) => {
+            let c = canvas::parse(first)?;
+            Some(Placement {
+                name: c.name,
+                platform: Layout::Canvas,
+                id: c.user_id,
+                late: c.late,
+                folder: canvas_folder(archive, &c),
+                relative: c.original,
+            })
+        }
+        _ => None,
+    }
+}
+
+/// Students as they are found, grouped by their id on the platform (a folder's name for plain
+/// folders).
+#[derive(Default)]
+struct Found {
+    students: BTreeMap<(Layout, String), Student>,
+    ignored: Vec<String>,
+}
+
+impl Found {
+    fn folder(&mut self, name: &str, path: &Path) {
+        let student = Student {
+            name: name.to_owned(),
+            lms: None,
+            source: Source::Folder(path.to_path_buf()),
+            shown: path.to_path_buf(),
+            refused: Vec::new(),
+        };
+        self.students.insert((Layout::Folders, name.to_owned()), student);
+    }
+
+    /// The student `place` names, made on first sight.
+    fn student(&mut self, place: &Placement) -> &mut Student {
+        let key = match place.platform {
+            Layout::Folders => place.name,
+            _ => place.id,
+        };
+        let student = self
+            .students
+            .entry((place.platform, key.to_owned()))
+            .or_insert_with(|| Student {
+                name: place.name.to_owned(),
+                lms: (place.platform != Layout::Folders).then(|| LmsId {
+                    platform: place.platform,
+                    id: place.id.to_owned(),
+                    late: false,
+                }),
+                source: Source::Files(Vec::new()),
+                shown: place.folder.clone(),
+                refused: Vec::new(),
+            });
+        if let Some(lms) = &mut student.lms {
+            lms.late |= place.late;
+        }
+        student
+    }
+
+    fn add(&mut self, place: &Placement, item: Item) {
+        if let Source::Files(items) = &mut self.student(place).source {
+            items.push(item);
+        }
+    }
+
+    fn refuse(&mut self, place: &Placement, refusal: Refusal) {
+        let relative = PathBuf::from(place.relative);
+        self.student(place).refused.push((relative, refusal));
+    }
+
+    /// The class, students sorted by name then id, names made distinct by their id.
+    fn class(self, layout: Layout, archive: Option<PathBuf>, refused: Vec<Refusal>) -> Class {
+        let mut students: Vec<Student> = self.students.into_values().collect();
+        let id = |s: &Student| s.lms.as_ref().map(|l| l.id.clone()).unwrap_or_default();
+        students.sort_by(|a, b| a.name.cmp(&b.name).then_with(|| id(a).cmp(&id(b))));
+        let mut counts: BTreeMap<String, usize> = BTreeMap::new();
+        for student in &students {
+            *counts.entry(student.name.clone()).or_default() += 1;
+        }
+        for student in &mut students {
+            if counts[&student.name] > 1
+                && let Some(lms) = &student.lms
+            {
+                student.name = format!("{} ({})", student.name, lms.id);
+            }
+        }
+        let mut ignored = self.ignored;
+        ignored.sort();
+        Class {
+            layout,
+            archive,
+            students,
+            ignored,
+            refused,
+        }
+    }
+}

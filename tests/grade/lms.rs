@@ -1,0 +1,550 @@
+//! Grading a learning platform's download as it comes: one class zipped as Canvas and as Moodle
+//! hand it over (and extracted, and as plain folders) grades alike, with the platform's names and
+//! ids; hostile archive entries are refused one by one; the grades go back as each platform's
+//! CSV; resuming and shards hold for a zip.
+
+use std::fs;
+use std::io::{Cursor, Write};
+use std::path::{Path, PathBuf};
+
+use goldray::grade::{ClassReport, GradeOptions, Layout, Outcome, Shard, grade_class, merge_shards};
+use goldray::progress::Silent;
+use image::{Rgb, RgbImage};
+use zip::ZipWriter;
+use zip::write::SimpleFileOptions;
+
+use crate::class::{case, pictures, render, rubric_text, scene_path};
+use crate::{chromium, parse_csv};
+
+/// One student of the class: the name each platform gives them, their ids, and their files.
+struct Student {
+    full_name: &'static str,
+    canvas: &'static str,
+    id: &'static str,
+    late: bool,
+    files: Vec<(String, Vec<u8>)>,
+}
+
+fn png(picture: &RgbImage) -> Vec<u8> {
+    goldray::film::encode_png(picture).unwrap()
+}
+
+/// A zip of `entries` (name, bytes), deflated.
+fn zip_of(entries: &[(String, Vec<u8>)]) -> Vec<u8> {
+    let mut zip = ZipWriter::new(Cursor::new(Vec::new()));
+    let options = SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
+    for (name, bytes) in entries {
+        zip.start_file(name, options).unwrap();
+        zip.write_all(bytes).unwrap();
+    }
+    zip.finish().unwrap().into_inner()
+}
+
+/// Four students: one perfect, one late with a broken colour picture, one who uploaded a zip of
+/// their own (with a colour picture nearly identical to the late one's), one who named a file
+/// wrong.
+fn students() -> Vec<Student> {
+    let [color, normals, depth] = pictures(&render(&case()));
+    let mut broken = color.clone();
+    for y in 0..40 {
+        for x in 0..100 {
+            broken.put_pixel(x, y, Rgb([0, 0, 0]));
+        }
+    }
+    // At 100×100 one pixel is 0.01% of the picture: only an identical copy is paired.
+    let nearly = broken.clone();
+    let good = |color: &RgbImage| {
+        vec![
+            ("color.png".to_owned(), png(color)),
+            ("normals.png".to_owned(), png(&normals)),
+            ("depth.png".to_owned(), png(&depth)),
+        ]
+    };
+    let own_zip = zip_of(
+        &good(&nearly)
+            .into_iter()
+            .map(|(name, bytes)| (format!("out/{name}"), bytes))
+            .collect::<Vec<_>>(),
+    );
+    let mut wrong_name = good(&color);
+    wrong_name[0].0 = "colour.png".to_owned();
+    vec![
+        Student {
+            full_name: "Ada Lovelace",
+            canvas: "lovelaceada",
+            id: "101",
+            late: false,
+            files: good(&color),
+        },
+        Student {
+            full_name: "Brian Kernighan",
+            canvas: "kernighanbrian",
+            id: "102",
+            late: true,
+            files: good(&broken),
+        },
+        Student {
+            full_name: "Grace Hopper",
+            canvas: "hoppergrace",
+            id: "103",
+            late: false,
+            files: vec![("renders.zip".to_owned(), own_zip)],
+        },
+        Student {
+            full_name: "Dennis Ritchie",
+            canvas: "ritchiedennis",
+            id: "104",
+            late: false,
+            files: wrong_name,
+        },
+    ]
+}
+
+fn canvas_name(student: &Student, file: &str) -> String {
+    let late = if student.late { "LATE_" } else { "" };
+    format!("{}_{late}{}_9{}_{file}", student.canvas, student.id, student.id)
+}
+
+fn moodle_folder(student: &Student) -> String {
+    format!("{}_{}_assignsubmission_file_", student.full_name, student.id)
+}
+
+fn canvas_zip(students: &[Student]) -> Vec<u8> {
+    zip_of(
+        &students
+            .iter()
+            .flat_map(|s| s.files.iter().map(move |(f, b)| (canvas_name(s, f), b.clone())))
+            .collect::<Vec<_>>(),
+    )
+}
+
+fn moodle_zip(students: &[Student]) -> Vec<u8> {
+    let mut entries: Vec<(String, Vec<u8>)> = students
+        .iter()
+        .flat_map(|s| {
+            s.files
+                .iter()
+                .map(move |(f, b)| (format!("{}/{f}", moodle_folder(s)), b.clone()))
+        })
+        .collect();
+    entries.push((
+        "Ada Lovelace_101_assignsubmission_onlinetext_/onlinetext.html".to_owned(),
+        b"<p>see my renders</p>".to_vec(),
+    ));
+    zip_of(&entries)
+}
+
+/// The class as plain folders, named by full name, each student's own zip extracted.
+fn folders(students: &[Student], dir: &Path) {
+    for student in students {
+        let folder = dir.join(student.full_name);
+        for (file, bytes) in &student.files {
+            if file.ends_with(".zip") {
+                let mut archive = zip::ZipArchive::new(Cursor::new(bytes)).unwrap();
+                archive.extract(&folder).unwrap();
+            } else {
+                fs::create_dir_all(&folder).unwrap();
+                fs::write(folder.join(file), bytes).unwrap();
+            }
+        }
+    }
+}
+
+fn grade(dir: &Path, submissions: &Path, out: &str) -> ClassReport {
+    let options = GradeOptions {
+        out: dir.join(out),
+        cache: Some(dir.join("cache")),
+        ..GradeOptions::default()
+    };
+    grade_class(&dir.join("rubric.toml"), submissions, &options, &Silent).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// A student's platform id, each image's verdict and points, and the total.
+type Score = (String, Vec<(&'static str, f64)>, f64);
+
+/// Each student's verdicts and points by platform id (by full name for plain folders).
+fn scores(report: &ClassReport, students: &[Student]) -> Vec<Score> {
+    let mut scores: Vec<_> = report
+        .students
+        .iter()
+        .map(|s| {
+            let id = match &s.lms {
+                Some(lms) => lms.id.clone(),
+                None => students.iter().find(|t| t.full_name == s.name).unwrap().id.to_owned(),
+            };
+            (
+                id,
+                s.images.iter().map(|i| (i.outcome.word(), i.points)).collect(),
+                s.total,
+            )
+        })
+        .collect();
+    scores.sort_by(|a, b| a.0.cmp(&b.0));
+    scores
+}
+
+fn setup(extra: &str) -> (tempfile::TempDir, Vec<Student>) {
+    let dir = tempfile::tempdir().unwrap();
+    fs::write(dir.path().join("rubric.toml"), rubric_text(&scene_path()) + extra).unwrap();
+    (dir, students())
+}
+
+#[test]
+fn canvas_and_moodle_downloads_grade_like_folders_with_the_platforms_names_and_ids() {
+    let (dir, students) = setup("\n[lms]\nassignment = \"Assignment 4 (1234)\"\n");
+    let dir = dir.path();
+    folders(&students, &dir.join("folders"));
+    fs::write(dir.join("canvas.zip"), canvas_zip(&students)).unwrap();
+    fs::write(dir.join("moodle.zip"), moodle_zip(&students)).unwrap();
+    let extracted = dir.join("moodle-extracted");
+    zip::ZipArchive::new(Cursor::new(moodle_zip(&students)))
+        .unwrap()
+        .extract(&extracted)
+        .unwrap();
+
+    let plain = grade(dir, &dir.join("folders"), "plain");
+    let canvas = grade(dir, &dir.join("canvas.zip"), "canvas");
+    let moodle = grade(dir, &dir.join("moodle.zip"), "moodle");
+    let unzipped = grade(dir, &extracted, "unzipped");
+    assert_eq!(plain.layout, Layout::Folders);
+    assert_eq!(canvas.layout, Layout::Canvas);
+    assert_eq!(moodle.layout, Layout::Moodle);
+    assert_eq!(unzipped.layout, Layout::Moodle);
+    let expected = scores(&plain, &students);
+    assert_eq!(expected.len(), 4);
+    // The late student lost points on colour, the wrong name costs colour, the own zip is read.
+    assert_eq!(expected[1].1[0], ("fail", 0.0));
+    assert_eq!(expected[2].1, [("fail", 0.0), ("pass", 1.0), ("pass", 1.0)]);
+    assert_eq!(expected[3].1[0], ("missing", 0.0));
+    for report in [&canvas, &moodle, &unzipped] {
+        assert_eq!(scores(report, &students), expected, "{:?}", report.layout);
+    }
+
+    for student in &students {
+        let graded = canvas.students.iter().find(|s| s.name == student.canvas).unwrap();
+        let lms = graded.lms.as_ref().unwrap();
+        assert_eq!(
+            (lms.platform, lms.id.as_str(), lms.late),
+            (Layout::Canvas, student.id, student.late)
+        );
+        let graded = moodle.students.iter().find(|s| s.name == student.full_name).unwrap();
+        assert_eq!(graded.lms.as_ref().unwrap().id, student.id);
+    }
+    // Where each graded file was, in the download: the same every run, never the staging folder.
+    let grace = canvas.students.iter().find(|s| s.name == "hoppergrace").unwrap();
+    assert_eq!(
+        grace.images[0].graded_file.as_deref(),
+        Some(
+            dir.join("canvas.zip/hoppergrace_103_9103_renders.zip/out/color.png")
+                .as_path()
+        )
+    );
+    let ada = moodle.students.iter().find(|s| s.name == "Ada Lovelace").unwrap();
+    assert_eq!(
+        ada.images[1].graded_file.as_deref(),
+        Some(
+            dir.join("moodle.zip/Ada Lovelace_101_assignsubmission_file_/normals.png")
+                .as_path()
+        )
+    );
+    // The copy inside Grace's own zip is paired with the late student's picture.
+    for report in [&plain, &canvas, &moodle] {
+        assert_eq!(report.similar.len(), 1, "{:?}: {:?}", report.layout, report.similar);
+        assert_eq!(report.similar[0].files, ["color.png"]);
+    }
+    let json = fs::read_to_string(dir.join("canvas/grades.json")).unwrap();
+    assert!(
+        json.contains("\"layout\": \"canvas\"") && json.contains("\"id\": \"102\""),
+        "{json}"
+    );
+    assert!(
+        !json.contains("goldray-grade-"),
+        "a staging path leaked into grades.json"
+    );
+    let csv = parse_csv(&fs::read_to_string(dir.join("canvas/grades.csv")).unwrap());
+    assert_eq!(csv[1][0], "hoppergrace");
+}
+
+#[test]
+fn the_platforms_csvs_read_back_with_their_columns_and_values() {
+    let (dir, students) = setup("\n[lms]\nassignment = \"Assignment 4 (1234)\"\n");
+    let dir = dir.path();
+    fs::write(dir.join("canvas.zip"), canvas_zip(&students)).unwrap();
+    fs::write(dir.join("moodle.zip"), moodle_zip(&students)).unwrap();
+    grade(dir, &dir.join("canvas.zip"), "canvas");
+    grade(dir, &dir.join("moodle.zip"), "moodle");
+
+    let canvas = parse_csv(&fs::read_to_string(dir.join("canvas/grades-canvas.csv")).unwrap());
+    assert_eq!(
+        canvas[0],
+        [
+            "Student",
+            "ID",
+            "SIS User ID",
+            "SIS Login ID",
+            "Section",
+            "Assignment 4 (1234)"
+        ]
+    );
+    assert_eq!(canvas[1], ["Points Possible", "", "", "", "", "4"]);
+    let row = |id: &str| canvas.iter().find(|r| r[1] == id).unwrap().clone();
+    assert_eq!(row("101"), ["lovelaceada", "101", "", "", "", "4"]);
+    assert_eq!(row("102")[5], "2");
+    assert_eq!(row("104")[5], "2");
+    assert_eq!(canvas.len(), 2 + students.len());
+    assert!(!dir.join("canvas/grades-moodle.csv").exists());
+
+    let moodle = parse_csv(&fs::read_to_string(dir.join("moodle/grades-moodle.csv")).unwrap());
+    assert_eq!(
+        moodle[0],
+        [
+            "Identifier",
+            "Full name",
+            "Email address",
+            "Status",
+            "Grade",
+            "Maximum Grade",
+            "Grade can be changed",
+            "Last modified (submission)",
+            "Last modified (grade)",
+            "Feedback comments"
+        ]
+    );
+    let row = |id: &str| {
+        moodle
+            .iter()
+            .find(|r| r[0] == format!("Participant {id}"))
+            .unwrap()
+            .clone()
+    };
+    let brian = row("102");
+    assert_eq!(
+        (brian[1].as_str(), brian[4].as_str(), brian[5].as_str()),
+        ("Brian Kernighan", "2", "4")
+    );
+    let feedback = &brian[9];
+    assert!(feedback.contains("color.png: fail, 0 of 2 points"), "{feedback}");
+    assert!(feedback.contains("normals.png: pass, 1 of 1 points"), "{feedback}");
+    assert!(feedback.contains("Total: 2 of 4 points"), "{feedback}");
+    // The darkened band is a mistake the diagnosis names, or says it cannot.
+    assert!(feedback.lines().count() == 4, "{feedback}");
+    assert!(row("104")[9].contains("color.png: missing, 0 of 2 points"));
+    assert!(!dir.join("moodle/grades-canvas.csv").exists());
+}
+
+#[test]
+fn a_malformed_lms_table_is_a_located_rubric_error() {
+    let (dir, _) = setup("\n[lms]\nassignment = \"\"\n");
+    let options = GradeOptions {
+        out: dir.path().join("out"),
+        cache: Some(dir.path().join("cache")),
+        ..GradeOptions::default()
+    };
+    let error = grade_class(&dir.path().join("rubric.toml"), dir.path(), &options, &Silent)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(error.contains("rubric.toml:") && error.contains("empty"), "{error}");
+}
+
+#[test]
+fn a_zip_resumes_by_student_and_shards_by_student_into_the_same_bytes() {
+    let (dir, mut students) = setup("");
+    let dir = dir.path();
+    let zip = dir.join("canvas.zip");
+    fs::write(&zip, canvas_zip(&students)).unwrap();
+    let first = grade(dir, &zip, "whole");
+    let csv = fs::read(dir.join("whole/grades.csv")).unwrap();
+    let json = fs::read(dir.join("whole/grades.json")).unwrap();
+    let again = grade(dir, &zip, "whole");
+    assert_eq!(again.cost.reused, 4, "an unchanged zip regrades nobody");
+    assert_eq!(fs::read(dir.join("whole/grades.json")).unwrap(), json);
+
+    for k in 1..=2 {
+        let options = GradeOptions {
+            out: dir.join(format!("shard{k}")),
+            cache: Some(dir.join("cache")),
+            shard: Shard { index: k, count: 2 },
+            ..GradeOptions::default()
+        };
+        let slice = grade_class(&dir.join("rubric.toml"), &zip, &options, &Silent).unwrap();
+        assert_eq!(slice.students.len(), 2, "two students a shard");
+    }
+    merge_shards(&dir.join("merged"), &[dir.join("shard2"), dir.join("shard1")]).unwrap();
+    assert_eq!(fs::read(dir.join("merged/grades.csv")).unwrap(), csv);
+    assert_eq!(fs::read(dir.join("merged/grades.json")).unwrap(), json);
+
+    // Brian hands in a fixed picture: only he is graded again.
+    students[1].files = students[0].files.clone();
+    fs::write(&zip, canvas_zip(&students)).unwrap();
+    let fixed = grade(dir, &zip, "whole");
+    assert_eq!((fixed.cost.reused, fixed.cost.graded), (3, 1));
+    assert_eq!(first.students.len(), fixed.students.len());
+}
+
+/// Patches every occurrence of `from` in `bytes` (names in local and central headers).
+fn rename(bytes: &mut [u8], from: &[u8], to: &[u8]) {
+    assert_eq!(from.len(), to.len());
+    let mut at = 0;
+    while let Some(i) = bytes[at..].windows(from.len()).position(|w| w == from) {
+        bytes[at + i..at + i + to.len()].copy_from_slice(to);
+        at += i + to.len();
+    }
+}
+
+/// Sets the encryption flag of the entry named `name`, in its local and central headers.
+fn encrypt_flag(bytes: &mut [u8], name: &[u8]) {
+    let mut at = 0;
+    while let Some(i) = bytes[at..].windows(name.len()).position(|w| w == name) {
+        let start = at + i;
+        if bytes[start - 46..start - 42] == [0x50, 0x4b, 0x01, 0x02] {
+            bytes[start - 46 + 8] |= 1;
+        } else if bytes[start - 30..start - 26] == [0x50, 0x4b, 0x03, 0x04] {
+            bytes[start - 30 + 6] |= 1;
+        }
+        at = start + name.len();
+    }
+}
+
+#[test]
+fn hostile_entries_are_refused_one_by_one_and_the_others_graded() {
+    let (dir, students) = setup("");
+    let dir = dir.path();
+    let honest = &students[..2];
+    let mut zip = ZipWriter::new(Cursor::new(Vec::new()));
+    let deflated = SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
+    for student in honest {
+        for (file, bytes) in &student.files {
+            zip.start_file(canvas_name(student, file), deflated).unwrap();
+            zip.write_all(bytes).unwrap();
+        }
+    }
+    let outside = dir.join("outside");
+    fs::create_dir_all(&outside).unwrap();
+    let absolute = outside.join("absolute.png");
+    zip.start_file("../../x.png", deflated).unwrap();
+    zip.write_all(b"escape").unwrap();
+    zip.start_file(absolute.display().to_string(), deflated).unwrap();
+    zip.write_all(b"escape").unwrap();
+    zip.start_file("mallorymal_105_9105_../../y.png", deflated).unwrap();
+    zip.write_all(b"escape").unwrap();
+    zip.add_symlink("mallorymal_105_9105_color.png", "/etc/passwd", deflated)
+        .unwrap();
+    // A gigabyte of zeros: about a megabyte deflated.
+    zip.start_file("mallorymal_105_9105_depth.png", deflated).unwrap();
+    let zeros = vec![0u8; 1 << 20];
+    for _ in 0..1024 {
+        zip.write_all(&zeros).unwrap();
+    }
+    let truncated = zip_of(&[("normals.png".to_owned(), students[0].files[1].1.clone())]);
+    zip.start_file("mallorymal_105_9105_renders.zip", deflated).unwrap();
+    zip.write_all(&truncated[..truncated.len() / 2]).unwrap();
+    for name in ["aaaa.png", "bbbb.png", "secret.png"] {
+        zip.start_file(format!("mallorymal_105_9105_{name}"), deflated).unwrap();
+        zip.write_all(name.as_bytes()).unwrap();
+    }
+    let mut bytes = zip.finish().unwrap().into_inner();
+    assert!(bytes.len() < 4 << 20, "the bomb is small: {} bytes", bytes.len());
+    rename(&mut bytes, b"bbbb.png", b"aaaa.png");
+    encrypt_flag(&mut bytes, b"mallorymal_105_9105_secret.png");
+    fs::write(dir.join("class.zip"), &bytes).unwrap();
+    let before = listing(dir);
+
+    let report = grade(dir, &dir.join("class.zip"), "report");
+    assert_eq!(report.students.len(), 3);
+    let expected = [("pass", 2.0), ("pass", 1.0), ("pass", 1.0)];
+    let ada = &report.students.iter().find(|s| s.name == "lovelaceada").unwrap();
+    assert_eq!(
+        ada.images
+            .iter()
+            .map(|i| (i.outcome.word(), i.points))
+            .collect::<Vec<_>>(),
+        expected
+    );
+    let mallory = report.students.iter().find(|s| s.name == "mallorymal").unwrap();
+    assert!(
+        matches!(mallory.images[0].outcome, Outcome::Linked { .. }),
+        "{:?}",
+        mallory.images[0]
+    );
+    assert!(
+        matches!(mallory.images[2].outcome, Outcome::TooLarge { .. }),
+        "{:?}",
+        mallory.images[2]
+    );
+    assert_eq!(mallory.images[1].outcome, Outcome::Missing);
+    let notes = mallory.refused.join("\n");
+    for expected in [
+        "color.png: a symbolic link",
+        "depth.png: 1073741824 bytes uncompressed, over the limit",
+        "renders.zip: not a readable zip archive",
+        "aaaa.png: the archive holds several files of this name",
+        "secret.png: encrypted",
+    ] {
+        assert!(notes.contains(expected), "no `{expected}` in:\n{notes}");
+    }
+    let loose: Vec<String> = report.refused.iter().map(|r| r.note()).collect();
+    assert_eq!(loose.len(), 3, "the entries that name no student: {loose:?}");
+    assert!(
+        loose.iter().all(|n| n.contains("leaves the archive's folder")),
+        "{loose:?}"
+    );
+
+    // Nothing was written but the report (and the golden cache it was told to use).
+    assert_eq!(listing(dir), before);
+    assert!(!absolute.exists() && !dir.join("x.png").exists() && !dir.parent().unwrap().join("x.png").exists());
+    let html = fs::read_to_string(dir.join("report").join(&mallory.page)).unwrap();
+    assert!(
+        html.contains("a symbolic link in the archive"),
+        "the student's page names the refusals"
+    );
+}
+
+/// Every path under `dir` outside the report and the cache.
+fn listing(dir: &Path) -> Vec<PathBuf> {
+    fn walk(dir: &Path, into: &mut Vec<PathBuf>) {
+        for entry in fs::read_dir(dir).unwrap().flatten() {
+            let path = entry.path();
+            if path.ends_with("report") || path.ends_with("cache") {
+                continue;
+            }
+            if path.is_dir() {
+                walk(&path, into);
+            }
+            into.push(path);
+        }
+    }
+    let mut paths = Vec::new();
+    walk(dir, &mut paths);
+    paths.sort();
+    paths
+}
+
+#[test]
+fn a_zip_graded_class_report_opens_in_headless_chromium() {
+    let (dir, students) = setup("");
+    let dir = dir.path();
+    fs::write(dir.join("canvas.zip"), canvas_zip(&students)).unwrap();
+    let report = grade(dir, &dir.join("canvas.zip"), "report");
+    let index = dir.join("report/index.html");
+    let dom = chromium::dump_dom(&index);
+    assert_eq!(
+        dom.matches("<tr><td class=\"name\">").count(),
+        report.students.len(),
+        "{dom}"
+    );
+    assert!(dom.contains("read as a Canvas download"), "{dom}");
+    assert!(
+        dom.contains("Canvas user 102 <span class=\"late\">late</span>"),
+        "{dom}"
+    );
+    assert!(dom.contains("data-images-broken=\"0\""), "{dom}");
+    let shot_path = Path::new(env!("CARGO_TARGET_TMPDIR")).join("lms-report.png");
+    let shot = chromium::screenshot(&index, 1300, 900, &shot_path);
+    let colours: std::collections::HashSet<[u8; 3]> = shot.pixels().map(|p| p.0).collect();
+    assert!(
+        colours.len() > 200,
+        "the screenshot looks blank: {} colours",
+        colours.len()
+    );
+}
