@@ -459,6 +459,10 @@ fn the_static_page_and_the_diff_page_show_the_case_without_buttons() {
     let project = changed_project();
     let root = project.path();
     fail_golden_check(root);
+    // A pending render that does not decode is named on the page; the other case is still shown.
+    let golden = root.join("golden");
+    fs::copy(golden.join(format!("{CASE}.snap.new")), golden.join("broken.snap.new")).unwrap();
+    fs::write(golden.join("broken.snap.new.exr"), b"not an EXR").unwrap();
     let before = files(root);
     let out = tempfile::tempdir().unwrap();
     let written = review(root, &["--static", out.path().to_str().unwrap()]);
@@ -471,6 +475,7 @@ fn the_static_page_and_the_diff_page_show_the_case_without_buttons() {
         "data-images-loaded=\"3\"",
         "data-panes-drawn=\"2\"",
         "read-only copy",
+        "cannot show broken: ",
     ] {
         assert!(dom.contains(expected), "the static page lacks `{expected}`:\n{dom}");
     }

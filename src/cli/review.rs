@@ -92,8 +92,10 @@ fn list(project: &Project) -> Result<ExitCode, Failure> {
         eprintln!("no pending golden");
     }
     for pending in &list.pending {
-        let review = CaseReview::of_pending(project, pending)?;
-        say!("{}\t{}\t{}", pending.name, review.verdict_word(), summary(&review));
+        match CaseReview::of_pending(project, pending) {
+            Ok(review) => say!("{}\t{}\t{}", pending.name, review.verdict_word(), summary(&review)),
+            Err(error) => say!("{}\tUNREADABLE\t{error}", pending.name),
+        }
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -42,17 +42,21 @@ use site::Site;
 /// `--static` writes (`decisions`: whether the page has buttons).
 pub fn review_project(project: &Project, decisions: bool) -> Result<(Heading, Vec<CaseReview>), ReviewError> {
     let list = project.pending()?;
-    let reviews = list
-        .pending
-        .iter()
-        .map(|pending| CaseReview::of_pending(project, pending))
-        .collect::<Result<Vec<_>, _>>()?;
-    let count = reviews.len();
     let mut notes: Vec<String> = list
         .skipped
         .iter()
         .map(|(path, reason)| format!("skipped {}: {reason}", relative(&project.root, path)))
         .collect();
+    // A case that cannot be shown (its new render does not decode) is named, and the others
+    // are still shown.
+    let mut reviews = Vec::with_capacity(list.pending.len());
+    for pending in &list.pending {
+        match CaseReview::of_pending(project, pending) {
+            Ok(review) => reviews.push(review),
+            Err(error) => notes.push(format!("cannot show {}: {error}", pending.name)),
+        }
+    }
+    let count = reviews.len();
     if !decisions && count > 0 {
         notes.push(
             "A read-only copy. To decide, run `goldray review` in the project (or `goldray review --accept NAME`)."
