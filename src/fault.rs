@@ -53,6 +53,7 @@ named_enum! {
         FalloffPlusOne = "falloff-plus-one",
         NoFalloff = "no-falloff",
         DirectionalFlipped = "directional-flipped",
+        PointLightMissing = "point-light-missing",
         // Shadows.
         NoShadows = "no-shadows",
         ShadowAcne = "shadow-acne",
@@ -75,6 +76,12 @@ named_enum! {
         PixelMapping = "pixel-mapping",
         FovHalfAngle = "fov-half-angle",
         UpOrthonormalized = "up-orthonormalized",
+        PlaneMissing = "plane-missing",
+        TriangleMissing = "triangle-missing",
+        TransformMissing = "transform-missing",
+        // Sampling.
+        NoJitter = "no-jitter",
+        NoFilter = "no-filter",
         // Outputs.
         GammaApplied = "gamma-applied",
         ColorNotClamped = "color-not-clamped",
@@ -84,6 +91,7 @@ named_enum! {
         DepthMissWhite = "depth-miss-white",
         CubemapFaceFlipped = "cubemap-face-flipped",
         CubemapIgnored = "cubemap-ignored",
+        BackgroundMissing = "background-missing",
     }
 }
 
@@ -96,6 +104,7 @@ pub enum Stage {
     Shadows,
     Reflection,
     Geometry,
+    Sampling,
     Outputs,
 }
 

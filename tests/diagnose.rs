@@ -148,6 +148,10 @@ const PAIRS: [&str; 5] = [
     "blinn-phong+normals-not-remapped",
 ];
 
+/// The course's starter code as shipped: flat colours, and no plane, triangle or transform
+/// intersection, no point light, no background (the point light cannot show under flat colours).
+const STARTER: &str = "nothing-shaded+plane-missing+triangle-missing+transform-missing+background-missing";
+
 struct Graded {
     dir: PathBuf,
     report: ClassReport,
@@ -169,6 +173,7 @@ fn grade(name: &str, perturbation: Perturbation) -> Graded {
     let mut students: Vec<(String, FaultSet)> = catalogue().into_iter().map(|s| (s.to_string(), s)).collect();
     students.extend(PAIRS.iter().map(|p| (p.replace('+', " + "), p.parse().unwrap())));
     students.push(("correct".to_owned(), FaultSet::NONE));
+    students.push(("starter".to_owned(), STARTER.parse().unwrap()));
     for (name, faults) in &students {
         write_student(&rubric, &renderers, faults, perturbation, &submissions.join(name));
         made.insert(name.clone(), *faults);
@@ -312,7 +317,7 @@ fn every_catalogue_fault_is_named_on_every_image_it_costs_points() {
     let graded = exact();
     let tally = tally(
         graded,
-        |name| !name.contains(" + ") && name != "correct" && name != "noisy",
+        |name| !name.contains(" + ") && !["correct", "noisy", "starter"].contains(&name),
         |_, _| true,
     );
     println!(
@@ -459,6 +464,36 @@ fn an_independent_programs_mistakes_are_diagnosed_too() {
     println!("graded in {:.1} s", graded.seconds);
     println!("{tally:#?}");
     let accuracy = tally.named as f64 / tally.lost.max(1) as f64;
+    let accused = accusations(graded);
+    println!(
+        "false accusations: {} of {} images that lost points and were named ({:.2}%)",
+        tally.wrong.len(),
+        accused,
+        100.0 * tally.wrong.len() as f64 / accused.max(1) as f64
+    );
+    // Acne drawn elsewhere (the camera moved) is still acne, by its signature.
+    let acne = student(graded, "shadow-acne")
+        .images
+        .iter()
+        .find(|i| i.file == "a07.png")
+        .unwrap();
+    assert_eq!(
+        acne.diagnosis.as_ref().map(|d| d.id.as_str()),
+        Some("shadow-acne"),
+        "{}",
+        acne.explanation
+    );
+    let starter = student(graded, "starter");
+    assert_eq!(
+        starter.unfinished.as_ref().map(|u| u.summary.as_str()),
+        Some("unfinished: shading, planes, triangles, transforms and the background are not implemented"),
+        "{:#?}",
+        starter
+            .images
+            .iter()
+            .map(|i| (&i.file, i.diagnosis.as_ref().map(|d| &d.id)))
+            .collect::<Vec<_>>()
+    );
     println!(
         "named {} of {} images that lost points ({:.1}%)",
         tally.named,
@@ -471,6 +506,41 @@ fn an_independent_programs_mistakes_are_diagnosed_too() {
         tally.wrong
     );
     assert!(accuracy >= 0.9, "{accuracy}");
+}
+
+/// How many images a class's diagnoses name a mistake on (what a false accusation is counted
+/// against).
+fn accusations(graded: &Graded) -> usize {
+    graded
+        .report
+        .students
+        .iter()
+        .flat_map(|s| &s.images)
+        .filter(|i| i.diagnosis.as_ref().is_some_and(|d| d.id != UNEXPLAINED))
+        .count()
+}
+
+/// The starter code as shipped is one "unfinished" finding with its parts, whatever its images
+/// draw alike (a missing transform and a reversed one; a narrow view and missing planes).
+#[test]
+fn the_starter_code_is_unfinished_with_its_parts() {
+    let graded = exact();
+    let starter = student(graded, "starter");
+    let unfinished = starter.unfinished.as_ref().expect("an unfinished finding");
+    let parts: Vec<&str> = unfinished.parts.iter().map(|p| p.id.as_str()).collect();
+    assert_eq!(parts, STARTER.split('+').collect::<Vec<_>>(), "{}", unfinished.summary);
+    let made: FaultSet = STARTER.parse().unwrap();
+    for image in starter.images.iter().filter(|i| goldray::grade::loses_points(i)) {
+        let diagnosis = image.diagnosis.as_ref().unwrap();
+        assert_ne!(diagnosis.id, UNEXPLAINED, "{}", image.file);
+        let named: FaultSet = diagnosis.id.parse().unwrap();
+        assert!(
+            named.faults().all(|f| made.contains(f)),
+            "{}: {}",
+            image.file,
+            diagnosis.id
+        );
+    }
 }
 
 #[test]

@@ -19,7 +19,7 @@ impl Fault {
             | LightColorIgnored
             | NothingShaded
             | FlatShading => Stage::Shading,
-            FalloffLinear | FalloffPlusOne | NoFalloff | DirectionalFlipped => Stage::Lights,
+            FalloffLinear | FalloffPlusOne | NoFalloff | DirectionalFlipped | PointLightMissing => Stage::Lights,
             NoShadows | ShadowAcne | ShadowsBeyondLight | NoAmbientInShadow => Stage::Shadows,
             NoReflections
             | ReflectionWithoutKs
@@ -35,9 +35,13 @@ impl Fault {
             | TriangleNormalFlipped
             | PixelMapping
             | FovHalfAngle
-            | UpOrthonormalized => Stage::Geometry,
+            | UpOrthonormalized
+            | PlaneMissing
+            | TriangleMissing
+            | TransformMissing => Stage::Geometry,
+            NoJitter | NoFilter => Stage::Sampling,
             GammaApplied | ColorNotClamped | NormalsNotRemapped | DepthInverted | DepthNotClamped | DepthMissWhite
-            | CubemapFaceFlipped | CubemapIgnored => Stage::Outputs,
+            | CubemapFaceFlipped | CubemapIgnored | BackgroundMissing => Stage::Outputs,
         }
     }
 
@@ -52,8 +56,13 @@ impl Fault {
             | FovHalfAngle
             | UpOrthonormalized
             | CubemapIgnored
-            | PixelMapping => Injection::Case,
-            NoShadows | NoReflections | WrongBounces => Injection::Trace,
+            | PixelMapping
+            | PointLightMissing
+            | PlaneMissing
+            | TriangleMissing
+            | TransformMissing
+            | BackgroundMissing => Injection::Case,
+            NoShadows | NoReflections | WrongBounces | NoJitter | NoFilter => Injection::Trace,
             GammaApplied | ColorNotClamped | NormalsNotRemapped | DepthInverted | DepthNotClamped | DepthMissWhite => {
                 Injection::Output
             }
@@ -72,7 +81,12 @@ impl Fault {
             | PlaneOneSided
             | PixelMapping
             | FovHalfAngle
-            | UpOrthonormalized => Pictures::ALL,
+            | UpOrthonormalized
+            | PlaneMissing
+            | TriangleMissing
+            | TransformMissing
+            | NoJitter
+            | NoFilter => Pictures::ALL,
             NormalsNotRemapped => Pictures::NORMALS,
             DepthInverted | DepthNotClamped | DepthMissWhite => Pictures::DEPTH,
             _ => Pictures::COLOR,
@@ -134,6 +148,22 @@ impl Fault {
             DepthMissWhite => "pixels that hit nothing are white in the depth image instead of black",
             CubemapFaceFlipped => "cube-map faces are read flipped",
             CubemapIgnored => "the cube map is ignored: rays that miss see the background colour",
+            PointLightMissing => {
+                "point lights are not implemented (PointLight::getIllumination is left empty): they shine nothing"
+            }
+            PlaneMissing => "planes are not implemented (Plane::intersect finds no hit): every plane is missing",
+            TriangleMissing => {
+                "triangles are not implemented (Triangle::intersect finds no hit): every triangle and mesh is missing"
+            }
+            TransformMissing => {
+                "transforms are not implemented (Transform::intersect finds no hit): every transformed object is missing"
+            }
+            BackgroundMissing => {
+                "the background is not implemented: rays that hit nothing are black instead of the background colour \
+                 or cube map"
+            }
+            NoJitter => "-jitter is not implemented: one ray per pixel instead of 16 jittered samples",
+            NoFilter => "-filter is not implemented: no 3× supersampling and Gaussian down-filter",
         }
     }
 
@@ -180,6 +210,26 @@ impl Fault {
             DepthMissWhite => "main: a pixel with no hit is black in the depth image",
             CubemapFaceFlipped => "CubeMap: the face's (u, v) and texel row order",
             CubemapIgnored => "RayTracer::traceRay: a miss returns the cube map's colour when the scene has one",
+            PointLightMissing => {
+                "PointLight::getIllumination: tolight = normalised (position − p), intensity = colour / (falloff · d²), \
+                 distToLight = d"
+            }
+            PlaneMissing => "Plane::intersect: t = (offset − n·origin)/(n·direction), kept if tmin < t < h.t",
+            TriangleMissing => {
+                "Triangle::intersect: solve for t and the barycentric coordinates (Cramer's rule), kept if inside and \
+                 tmin < t < h.t"
+            }
+            TransformMissing => {
+                "Transform::intersect: intersect the object with the ray moved by M⁻¹ (direction with w = 0), then \
+                 bring the normal back by (M⁻¹)ᵀ"
+            }
+            BackgroundMissing => {
+                "RayTracer::traceRay: a ray that hits nothing returns the background colour or cube map"
+            }
+            NoJitter => "Renderer::Render: with -jitter, average 16 stratified random samples in each pixel",
+            NoFilter => {
+                "Renderer::Render: with -filter, render at 3× and weight each 3×3 block by [1 2 1; 2 4 2; 1 2 1]/16"
+            }
         }
     }
 
@@ -194,6 +244,29 @@ impl Fault {
                 | Fault::CubemapFaceFlipped
                 | Fault::CubemapIgnored
         )
+    }
+
+    /// The part of the assignment a fault leaves unwritten, when the fault is the starter code's
+    /// `TODO` as shipped (or a feature of the command line never begun) rather than a mistake in
+    /// code that was written: a student with several of them is told once that the work is
+    /// unfinished, with the parts, instead of one mistake per part. `nothing-shaded` stands for
+    /// all of the shading (lights, Phong, shadows, reflections), which a flat colour hides.
+    pub const fn unfinished_part(self) -> Option<&'static str> {
+        use Fault::*;
+        Some(match self {
+            NothingShaded => "shading",
+            NoSpecular => "the specular highlight",
+            NoShadows => "shadows",
+            NoReflections => "reflections",
+            PointLightMissing => "point lights",
+            PlaneMissing => "planes",
+            TriangleMissing => "triangles",
+            TransformMissing => "transforms",
+            BackgroundMissing => "the background",
+            NoJitter => "jitter",
+            NoFilter => "the filter",
+            _ => return None,
+        })
     }
 
     /// Whether the fault's picture is noise whose speckles an independent program draws

@@ -249,6 +249,7 @@ fn grade_listed(
             let diagnosis_started = Instant::now();
             diagnoser.diagnose(&mut fresh)?;
             diagnose::prefer_consistent(&mut fresh);
+            diagnose::gather_unfinished(&mut fresh);
             diagnose::apply_credit(&rubric, &mut fresh);
             let share = diagnosis_started.elapsed().as_secs_f64() / fresh.len() as f64;
             for timings in &mut fresh_timings {

@@ -19,15 +19,21 @@
 //! single fault explains an image, the rest of each promising family is tried (every member of
 //! `wrong-bounces`, the unnormalised reflection's lengths, a gamma fitted by golden-section
 //! search) and then pairs of the faults that explained part of it. What nothing explains is
-//! `unexplained`. Speckled mistakes (acne) are compared over blocks, where an independent
-//! program's speckles, drawn elsewhere, have the same density.
+//! `unexplained`. Speckled mistakes (acne) alone are recognised by their signature
+//! ([`signature`]): an independent program's speckles fall elsewhere and come at another
+//! density, but darken the same surfaces in scattered pixels; with another mistake they are
+//! compared over blocks. Fault sets of any size are grown for images nothing smaller explains
+//! ([`grow`]), and a set naming a mistake in written code must be clearly closer than any set of
+//! parts not written ([`decide`]).
 
 mod batch;
 mod candidates;
 mod decide;
 mod expand;
+mod grow;
 mod pictures;
 mod residual;
+mod signature;
 mod student;
 
 use std::collections::HashSet;
@@ -36,7 +42,9 @@ use std::sync::{Arc, Mutex};
 
 use image::RgbImage;
 
-use super::diagnosis::{Closest, Confidence, Diagnosis, DiagnosisRun, RenderDiagnosis, Residual, UNEXPLAINED};
+use super::diagnosis::{
+    Closest, Confidence, Diagnosis, DiagnosisRun, RenderDiagnosis, Residual, UNEXPLAINED, Unfinished, UnfinishedPart,
+};
 use super::outcome::Outcome;
 use super::rubric::{ImageSpec, Rubric, Rule};
 use super::score::{ImageResult, StudentResult, judge};
@@ -47,7 +55,7 @@ use crate::film::{Picture, encode_png, picture_with_faults};
 pub(super) use batch::{Diagnoser, prepare_mistakes};
 use decide::decide;
 use expand::{expansions, fit_background, fit_gamma};
-pub(super) use student::{apply_credit, prefer_consistent};
+pub(super) use student::{apply_credit, gather_unfinished, prefer_consistent};
 
 /// A fault explains an image only if the image fails at most this many times fewer pixels
 /// against the fault's picture than against the golden one.
@@ -120,6 +128,11 @@ impl Scored {
             .min(ratio(self.residual.rmse, self.golden.rmse))
     }
 
+    /// How many of the set's faults are mistakes in written code rather than parts not written.
+    fn specific(&self) -> usize {
+        self.set.faults().filter(|f| f.unfinished_part().is_none()).count()
+    }
+
     fn key(&self) -> (f64, f64) {
         (self.residual.failing_fraction, self.residual.rmse)
     }
@@ -168,7 +181,15 @@ impl Subject<'_> {
     fn score_picture(&self, set: FaultSet, picture: &RgbImage) -> Scored {
         let threshold = self.spec.rule.threshold;
         let speckle = set.faults().any(Fault::is_speckle);
-        let (residual, golden) = if speckle {
+        // Shadow acne only darkens, which moving the camera by a fraction of a pixel does not do
+        // in scattered pixels of lit surfaces alone; reflection acne changes a mirror either way,
+        // as such a move does to a reflected texture, so it keeps the comparison over blocks.
+        let (residual, golden) = if set == FaultSet::single(Fault::ShadowAcne) {
+            (
+                signature::acne_residual(self.golden, picture, &self.student, threshold),
+                self.by_pixel,
+            )
+        } else if speckle {
             (
                 residual::block_residual(picture, &self.student, threshold, self.block),
                 self.by_block,

@@ -68,6 +68,27 @@ pub struct Closest {
     pub explained: f64,
 }
 
+/// A student whose diagnoses name several parts of the assignment that were never written (the
+/// starter code's `TODO`s as shipped: planes, triangles, transforms, the background…): one
+/// finding, "unfinished", with the parts and the images each explains, rather than one mistake
+/// per part. `grades.json` holds it per student.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Unfinished {
+    /// "unfinished: planes, triangles and the background are not implemented".
+    pub summary: String,
+    pub parts: Vec<UnfinishedPart>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct UnfinishedPart {
+    /// The catalogue id: `plane-missing`.
+    pub id: String,
+    /// What is not implemented: `planes`.
+    pub part: String,
+    /// The images whose diagnosis names it, in rubric order.
+    pub images: Vec<String>,
+}
+
 /// What diagnosing a class cost, render by render, for `grades.json` and the summary.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct DiagnosisRun {

@@ -9,7 +9,7 @@ use fast_image_resize::pixels::U8x3;
 use fast_image_resize::{FilterType, ResizeAlg, ResizeOptions, Resizer};
 use serde::{Deserialize, Serialize};
 
-use super::diagnosis::Diagnosis;
+use super::diagnosis::{Diagnosis, Unfinished};
 use super::golden::GOLDEN_DIR;
 use super::integrity::{Integrity, PUBLISHED_COPY, pixel_hash, refuse_link};
 use super::lms::{LmsId, Staged};
@@ -78,6 +78,9 @@ pub struct StudentResult {
     pub total: f64,
     pub max_points: f64,
     pub images: Vec<ImageResult>,
+    /// Several parts of the assignment never written, named once (see [`Unfinished`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub unfinished: Option<Unfinished>,
 }
 
 /// One student's folder, listed once, with the file-system and URL-safe name its pictures and
@@ -160,6 +163,7 @@ impl StudentResult {
             total: images.iter().map(|i| i.points).sum(),
             max_points: images.iter().map(|i| i.max_points).sum(),
             images,
+            unfinished: None,
         }
     }
 

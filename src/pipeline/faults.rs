@@ -13,7 +13,7 @@ use crate::case::{Case, LightSpec, ObjectSpec, ShapeSpec};
 use crate::error::Error;
 use crate::fault::{Fault, FaultSet, Injection, Mapping};
 use crate::film::Film;
-use crate::options::Precision;
+use crate::options::{Filter, Precision};
 use crate::precision::{double, single};
 use crate::progress::{Progress, Silent};
 use crate::with_precision;
@@ -94,6 +94,12 @@ pub fn case_with_faults(case: &Case, faults: &FaultSet) -> Case {
     if let Some(bounces) = faults.bounces() {
         trace.bounces = bounces;
     }
+    if faults.contains(Fault::NoJitter) {
+        trace.samples = 1;
+    }
+    if faults.contains(Fault::NoFilter) {
+        trace.filter = Filter::None;
+    }
     if faults.contains(Fault::NoAmbient) {
         case.background.ambient = [0.0; 3];
     }
@@ -102,6 +108,26 @@ pub fn case_with_faults(case: &Case, faults: &FaultSet) -> Case {
         // has one or the other); the family's member says which colour the program showed.
         case.background.cube_map = None;
         case.background.color = faults.background();
+    }
+    if faults.contains(Fault::BackgroundMissing) {
+        case.background.cube_map = None;
+        case.background.color = [0.0; 3];
+    }
+    if faults.contains(Fault::PointLightMissing) {
+        // The starter's getIllumination leaves its outputs as the caller made them: no light.
+        case.lights.retain(|l| !matches!(l, LightSpec::Point { .. }));
+    }
+    // The starter's intersections of these shapes find no hit: the objects are not there.
+    if faults.contains(Fault::PlaneMissing) {
+        remove_objects(&mut case.objects, &|o| matches!(o.shape, ShapeSpec::Plane { .. }));
+    }
+    if faults.contains(Fault::TriangleMissing) {
+        remove_objects(&mut case.objects, &|o| {
+            matches!(o.shape, ShapeSpec::Triangle { .. } | ShapeSpec::Mesh { .. })
+        });
+    }
+    if faults.contains(Fault::TransformMissing) {
+        remove_objects(&mut case.objects, &|o| !o.transform.is_empty());
     }
     if faults.contains(Fault::DirectionalFlipped) {
         for light in &mut case.lights {
@@ -138,6 +164,16 @@ pub fn orthonormal_up(direction: [f64; 3], up: [f64; 3]) -> [f64; 3] {
     let d = DVec3::from(direction).normalize();
     let up = DVec3::from(up);
     (up - d * d.dot(up)).normalize().to_array()
+}
+
+/// Every object `missing` says, at any depth of the groups, left out.
+fn remove_objects(objects: &mut Vec<ObjectSpec>, missing: &dyn Fn(&ObjectSpec) -> bool) {
+    objects.retain(|o| !missing(o));
+    for object in objects {
+        if let ShapeSpec::Group { objects } = &mut object.shape {
+            remove_objects(objects, missing);
+        }
+    }
 }
 
 fn reverse_transforms(objects: &mut [ObjectSpec]) {
@@ -204,6 +240,13 @@ pub fn fault_applies(case: &Case, fault: Fault) -> bool {
             DVec3::from(orthonormal_up(case.camera.direction, case.camera.up)).distance(up) > 1e-9
         }
         CubemapFaceFlipped | CubemapIgnored => case.background.cube_map.is_some(),
+        PointLightMissing => point_lights,
+        PlaneMissing => planes,
+        TriangleMissing => triangles,
+        TransformMissing => has_object(&case.objects, &|o| !o.transform.is_empty()),
+        BackgroundMissing => case.background.color != [0.0; 3] || case.background.cube_map.is_some(),
+        NoJitter => trace.samples > 1,
+        NoFilter => trace.filter == Filter::Gaussian,
         PixelMapping | GammaApplied | ColorNotClamped | NormalsNotRemapped => true,
         DepthInverted | DepthNotClamped | DepthMissWhite => true,
     }

@@ -16,7 +16,7 @@ use super::super::score::StudentResult;
 use super::super::submission::read_png;
 use super::{
     Candidate, Diagnosis, DiagnosisRun, RenderDiagnosis, Scored, Subject, UNEXPLAINED, candidates, decide, expansions,
-    fit_background, fit_gamma, loses_points, pictures, residual, student_dir,
+    fit_background, fit_gamma, grow, loses_points, pictures, residual, student_dir,
 };
 use crate::fault::FaultSet;
 use crate::film::Picture;
@@ -185,18 +185,24 @@ impl<'a> Diagnoser<'a> {
             let fault_sets = singles.len() + all_wanted.len();
             let expanded: Vec<Candidate> = all_wanted.into_par_iter().filter_map(get).collect();
 
-            let decided: Vec<Option<(Diagnosis, usize, usize)>> = failing
-                .par_iter()
-                .zip(subjects.par_iter().zip(scored.par_iter()))
-                .map(|(&(s, i), (subject, scores))| {
-                    let subject = subject.as_ref()?;
-                    let student_wants = wanted.get(&s).map_or(&[][..], Vec::as_slice);
-                    // In the order the student's images asked for them, whoever else asked.
-                    let expanded: Vec<&Candidate> = student_wants
+            // In the order the student's images asked for them, whoever else asked.
+            let asked: Vec<Vec<&Candidate>> = failing
+                .iter()
+                .map(|(s, _)| {
+                    let student_wants = wanted.get(s).map_or(&[][..], Vec::as_slice);
+                    student_wants
                         .iter()
                         .filter_map(|set| expanded.iter().find(|c| c.set == *set))
-                        .collect();
-                    let mut scores = scores.clone();
+                        .collect()
+                })
+                .collect();
+            let mut scored: Vec<Vec<Scored>> = subjects
+                .par_iter()
+                .zip(scored.into_par_iter().zip(asked.par_iter()))
+                .map(|(subject, (mut scores, expanded))| {
+                    let Some(subject) = subject.as_ref() else {
+                        return scores;
+                    };
                     let known = |set: &FaultSet| singles.iter().chain(expanded.iter().copied()).find(|c| c.set == *set);
                     // A pair that draws this picture as one of its faults alone does has no
                     // evidence of the other.
@@ -214,8 +220,20 @@ impl<'a> Diagnoser<'a> {
                             .filter_map(|c| subject.score(c)),
                     );
                     scores.extend(fit_gamma(subject, &store, &scores));
+                    scores
+                })
+                .collect();
+            // Several faults at once, for the images nothing above explains.
+            let known: Vec<&Candidate> = singles.iter().chain(&expanded).collect();
+            let grown = grow::grow(&subjects, &mut scored, &known, &singles, &get);
+            let fault_sets = fault_sets + grown.len();
+            let decided: Vec<Option<(Diagnosis, usize, usize)>> = failing
+                .par_iter()
+                .zip(subjects.par_iter().zip(scored.par_iter().zip(asked.par_iter())))
+                .map(|(&(s, i), (subject, (scores, expanded)))| {
+                    let subject = subject.as_ref()?;
                     let slug = student_dir(&students[s]);
-                    let diagnosis = decide(subject, &scores, &store, &expanded, &singles, out, &slug, &self.written);
+                    let diagnosis = decide(subject, scores, &store, expanded, &singles, out, &slug, &self.written);
                     Some((diagnosis, s, i))
                 })
                 .collect();

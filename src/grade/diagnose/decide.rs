@@ -16,18 +16,30 @@ pub(super) fn decide(
 ) -> Diagnosis {
     let rule = &subject.spec.rule;
     let mut explaining: Vec<&Scored> = scores.iter().filter(|s| s.explains(rule)).collect();
-    explaining.sort_by(|a, b| a.key().partial_cmp(&b.key()).unwrap_or(std::cmp::Ordering::Equal));
-    // Parsimony: the closest single fault, unless a pair is far closer.
-    let best_single = explaining.iter().find(|s| s.set.len() == 1).copied();
-    let best_pair = explaining.iter().find(|s| s.set.len() > 1).copied();
-    let mut order: Vec<&Scored> = match (best_single, best_pair) {
-        (Some(single), Some(pair)) if pair.left() * FAILING_REDUCTION < single.left() => {
-            vec![pair, single]
+    // The closest first; of sets that draw this picture equally well, the one with fewer
+    // mistakes in written code (a part not written is the likelier story, and no accusation).
+    explaining.sort_by(|a, b| {
+        a.key()
+            .partial_cmp(&b.key())
+            .unwrap_or(std::cmp::Ordering::Equal)
+            .then(a.specific().cmp(&b.specific()))
+    });
+    // Parsimony: the closest set of the fewest faults, unless a larger set is far closer.
+    let mut sizes: Vec<usize> = explaining.iter().map(|s| s.set.len()).collect();
+    sizes.sort_unstable();
+    sizes.dedup();
+    let mut order: Vec<&Scored> = Vec::new();
+    for size in sizes {
+        let Some(best) = explaining.iter().find(|s| s.set.len() == size).copied() else {
+            continue;
+        };
+        if order
+            .first()
+            .is_none_or(|chosen| best.left() * FAILING_REDUCTION < chosen.left())
+        {
+            order.insert(0, best);
         }
-        (Some(single), _) => vec![single],
-        (None, Some(pair)) => vec![pair],
-        (None, None) => Vec::new(),
-    };
+    }
     let rest: Vec<&Scored> = explaining
         .iter()
         .filter(|s| !order.iter().any(|o| o.set == s.set))
@@ -35,6 +47,7 @@ pub(super) fn decide(
         .copied()
         .collect();
     order.extend(rest);
+    let order = without_accusations(order, scores, rule);
     let picture_of = |set: &FaultSet| -> Option<RgbImage> {
         let index = subject.picture;
         if let Some(candidate) = singles.iter().chain(expanded.iter().copied()).find(|c| c.set == *set) {
@@ -78,11 +91,7 @@ pub(super) fn decide(
         let alternatives: Vec<String> = explaining
             .iter()
             .filter(|s| s.set.id() != scored.set.id() && s.set.len() <= scored.set.len())
-            .filter(|s| {
-                s.residual.failing_fraction
-                    <= (2.0 * scored.residual.failing_fraction).max(scored.residual.failing_fraction + 0.001)
-                    && s.residual.rmse <= 1.5 * scored.residual.rmse + 0.5
-            })
+            .filter(|s| as_close(s, scored))
             .map(|s| s.set.id())
             .fold(Vec::new(), |mut ids, id| {
                 if !ids.contains(&id) {
@@ -105,7 +114,7 @@ pub(super) fn decide(
             golden: scored.golden,
             residual: Some(scored.residual),
             residual_metrics: Some(metrics),
-            compared_by: compared_by(scored, subject.block),
+            compared_by: compared_by(scored, subject.block, signature::reach(subject.golden)),
             alternatives,
             closest: None,
             mistake_image,
@@ -156,8 +165,50 @@ pub(super) fn decide(
     }
 }
 
-fn compared_by(scored: &Scored, block: u32) -> String {
-    if scored.speckle {
+/// Never an accusation that "a part is not there" explains as well: each set that names a
+/// mistake in written code is replaced by a set of missing parts that draws the picture about as
+/// well and explains it; where such a set is about as close but does not explain the image, the
+/// evidence cannot tell a mistake from unfinished work, and nothing from there on is named.
+fn without_accusations<'a>(order: Vec<&'a Scored>, scores: &'a [Scored], rule: &Rule) -> Vec<&'a Scored> {
+    let mut kept: Vec<&Scored> = Vec::new();
+    for scored in order {
+        let chosen = match as_good_missing(scored, scores) {
+            None => scored,
+            Some(missing) if missing.explains(rule) => missing,
+            Some(_) => break,
+        };
+        if !kept.iter().any(|k| k.set == chosen.set) {
+            kept.push(chosen);
+        }
+    }
+    kept
+}
+
+/// The closest set of missing parts only that comes about as close as `scored` (the measure
+/// [`decide`]'s alternatives use), when `scored` names a mistake in written code.
+fn as_good_missing<'a>(scored: &Scored, scores: &'a [Scored]) -> Option<&'a Scored> {
+    if scored.specific() == 0 {
+        return None;
+    }
+    scores
+        .iter()
+        .filter(|m| m.specific() == 0 && m.speckle == scored.speckle)
+        .filter(|m| as_close(m, scored))
+        .min_by(|a, b| a.key().partial_cmp(&b.key()).unwrap_or(std::cmp::Ordering::Equal))
+}
+
+/// Whether `other` explains the image about as well as `scored`: at most twice its failing
+/// pixels (or a tenth of a percent more) and half again its RMSE.
+fn as_close(other: &Scored, scored: &Scored) -> bool {
+    other.residual.failing_fraction
+        <= (2.0 * scored.residual.failing_fraction).max(scored.residual.failing_fraction + 0.001)
+        && other.residual.rmse <= 1.5 * scored.residual.rmse + 0.5
+}
+
+fn compared_by(scored: &Scored, block: u32, reach: u32) -> String {
+    if scored.set == FaultSet::single(Fault::ShadowAcne) {
+        format!("the acne's signature: scattered speckles within {reach} pixels of the mistake's")
+    } else if scored.speckle {
         format!("blocks of {block}×{block} pixels")
     } else {
         "pixels".to_owned()

@@ -58,6 +58,8 @@ pub(in crate::grade) fn prefer_consistent(students: &mut [StudentResult]) {
             .flat_map(|d| d.id.split('+').map(str::to_owned).collect::<Vec<_>>())
             .collect();
         let made = |set: &FaultSet| set.faults().all(|f| clear.iter().any(|id| id == f.name()));
+        // Never from a part not written to a mistake in written code that draws the same.
+        let specific = |set: &FaultSet| set.faults().filter(|f| f.unfinished_part().is_none()).count();
         for image in &mut student.images {
             let Some(diagnosis) = &mut image.diagnosis else {
                 continue;
@@ -66,7 +68,8 @@ pub(in crate::grade) fn prefer_consistent(students: &mut [StudentResult]) {
             if current.as_ref().is_some_and(made) {
                 continue;
             }
-            let Some(better) = diagnosis.ties.iter().find(|t| made(t)).copied() else {
+            let most = current.as_ref().map_or(usize::MAX, specific);
+            let Some(better) = diagnosis.ties.iter().find(|t| made(t) && specific(t) <= most).copied() else {
                 continue;
             };
             let previous = std::mem::replace(&mut diagnosis.id, better.id());
@@ -76,5 +79,59 @@ pub(in crate::grade) fn prefer_consistent(students: &mut [StudentResult]) {
             diagnosis.explanation = better.explain();
             diagnosis.hints = better.faults().map(|f| f.hint().to_owned()).collect();
         }
+    }
+}
+
+/// How many distinct unwritten parts make a student's work "unfinished" (one finding) rather
+/// than a mistake or two, each named on its own.
+pub const UNFINISHED_PARTS: usize = 2;
+
+/// Gathers a student's "not implemented" diagnoses into one [`Unfinished`] finding when they
+/// name at least [`UNFINISHED_PARTS`] parts: a student who never wrote planes, triangles and
+/// transforms is told so in one line, with the images each part explains.
+pub(in crate::grade) fn gather_unfinished(students: &mut [StudentResult]) {
+    for student in students.iter_mut() {
+        student.unfinished = unfinished_of(student);
+    }
+}
+
+fn unfinished_of(student: &StudentResult) -> Option<Unfinished> {
+    let mut parts: Vec<(Fault, Vec<String>)> = Vec::new();
+    for image in &student.images {
+        let Some(diagnosis) = &image.diagnosis else { continue };
+        let Ok(set) = diagnosis.id.parse::<FaultSet>() else {
+            continue;
+        };
+        for fault in set.faults().filter(|f| f.unfinished_part().is_some()) {
+            match parts.iter_mut().find(|(known, _)| *known == fault) {
+                Some((_, images)) => images.push(image.file.clone()),
+                None => parts.push((fault, vec![image.file.clone()])),
+            }
+        }
+    }
+    if parts.len() < UNFINISHED_PARTS {
+        return None;
+    }
+    parts.sort_by_key(|(fault, _)| *fault as u32);
+    let names: Vec<&str> = parts.iter().filter_map(|(f, _)| f.unfinished_part()).collect();
+    Some(Unfinished {
+        summary: format!("unfinished: {} are not implemented", listed(&names)),
+        parts: parts
+            .into_iter()
+            .map(|(fault, images)| UnfinishedPart {
+                id: fault.name().to_owned(),
+                part: fault.unfinished_part().unwrap_or_default().to_owned(),
+                images,
+            })
+            .collect(),
+    })
+}
+
+/// `a`, `a and b`, `a, b and c`.
+fn listed(names: &[&str]) -> String {
+    match names {
+        [] => String::new(),
+        [one] => (*one).to_owned(),
+        [rest @ .., last] => format!("{} and {last}", rest.join(", ")),
     }
 }

@@ -5,7 +5,7 @@
 
 use std::fmt::Write as _;
 
-use super::super::diagnosis::{Confidence, Diagnosis, UNEXPLAINED};
+use super::super::diagnosis::{Confidence, Diagnosis, UNEXPLAINED, Unfinished};
 use super::super::golden::GOLDEN_DIR;
 use super::super::report::{ClassReport, format_points, mistakes_of};
 use super::super::score::{ImageResult, StudentResult, percent};
@@ -19,7 +19,7 @@ pub const STYLE: &str = r#"
 .bar.unexplained{background:#777}
 code.id{font-weight:600;color:#8a1c1c}
 section.mistake{background:#fff;border:1px solid #ccc;border-left:6px solid #8a1c1c;margin:1em 0;padding:.8em}
-section.mistake.unexplained{border-left-color:#777}
+section.mistake.unexplained{border-left-color:#777}section.mistake.unfinished{border-left-color:#b26a00}
 section.mistake .hint{color:#444}section.mistake .panes figure img{width:220px;height:220px}
 .confidence{font-size:.85em;color:#555}
 p.diagnosis{background:#fbeaea;border-radius:.3em;padding:.3em .5em}
@@ -127,6 +127,10 @@ pub fn summary(body: &mut String, student: &StudentResult) {
     if groups.is_empty() {
         return;
     }
+    // The parts never written are one finding, before the mistakes in what was written.
+    if let Some(unfinished) = &student.unfinished {
+        groups.retain(|(id, _)| !unfinished.parts.iter().any(|p| p.id == *id));
+    }
     let lost = |images: &[&ImageResult]| images.iter().map(|i| i.max_points - i.points).sum::<f64>();
     groups.sort_by(|a, b| {
         (a.0 == UNEXPLAINED)
@@ -134,6 +138,9 @@ pub fn summary(body: &mut String, student: &StudentResult) {
             .then(lost(&b.1).total_cmp(&lost(&a.1)))
     });
     body.push_str("<div id=\"mistakes\">\n<h2>What went wrong</h2>\n");
+    if let Some(unfinished) = &student.unfinished {
+        unfinished_section(body, student, unfinished);
+    }
     for (id, mut images) in groups {
         images.sort_by(|a, b| (b.max_points - b.points).total_cmp(&(a.max_points - a.points)));
         let links: Vec<String> = images
@@ -220,6 +227,50 @@ pub fn summary(body: &mut String, student: &StudentResult) {
         body.push_str("</section>\n");
     }
     body.push_str("</div>\n");
+}
+
+/// The one finding for the parts never written: the sentence, each part with where to start and
+/// the images it explains, and the pictures of the image that lost the most points.
+fn unfinished_section(body: &mut String, student: &StudentResult, unfinished: &Unfinished) {
+    let _ = writeln!(
+        body,
+        "<section class=\"mistake unfinished\" data-mistake=\"unfinished\"><h3>Unfinished</h3>\n<p>{}.</p>\n<ul>",
+        escape(&capitalised(&unfinished.summary))
+    );
+    for part in &unfinished.parts {
+        let hint = part.id.parse::<Fault>().map_or("", Fault::hint);
+        let links: Vec<String> = part
+            .images
+            .iter()
+            .map(|file| format!("<a href=\"#{file}\">{file}</a>", file = escape(file)))
+            .collect();
+        let _ = writeln!(
+            body,
+            "<li data-part=\"{id}\"><code class=\"id\">{id}</code>: {part}. <span class=\"hint\">Where to start: {}.</span> \
+             Explains {}.</li>",
+            escape(hint),
+            links.join(", "),
+            id = escape(&part.id),
+            part = escape(&part.part),
+        );
+    }
+    body.push_str("</ul>\n");
+    let lost = |i: &&ImageResult| i.max_points - i.points;
+    let worst = student
+        .images
+        .iter()
+        .filter(|i| {
+            i.diagnosis
+                .as_ref()
+                .is_some_and(|d| d.id.split('+').any(|id| unfinished.parts.iter().any(|p| p.id == id)))
+        })
+        .max_by(|a, b| lost(a).total_cmp(&lost(b)));
+    if let Some(image) = worst
+        && let Some(diagnosis) = &image.diagnosis
+    {
+        pictures(body, image, diagnosis, "the unfinished program's render");
+    }
+    body.push_str("</section>\n");
 }
 
 /// The line in an image's own section.
