@@ -17,7 +17,11 @@ use image::{RgbImage, imageops};
 const SIZE: u32 = 64;
 
 /// The course's seven grading commands at 64×64, with their depth ranges.
+/// Course scene `number` (1 to 7) with its graded flags; 8 is scene 01 with `-jitter -filter`,
+/// for the faults that act only where those are asked for.
 fn course(number: usize) -> Case {
+    let sampled = number == 8;
+    let number = if sampled { 1 } else { number };
     let (file, bounces, shadows) = [
         ("scene01_plane.txt", 0, false),
         ("scene02_cube.txt", 0, false),
@@ -34,6 +38,8 @@ fn course(number: usize) -> Case {
         shadows,
         depth_range: Some(depth_range(number)),
         normals: true,
+        jitter: sampled,
+        filter: sampled,
         ..AssignmentOptions::default()
     };
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/mit6837").join(file);
@@ -102,7 +108,7 @@ use Change::{Brighter, Darker, Moved, Same};
 #[test]
 fn every_fault_changes_what_it_should_and_nothing_else() {
     let own = own_scene();
-    let scenes: Vec<Case> = (1..=7).map(course).collect();
+    let scenes: Vec<Case> = (1..=8).map(course).collect();
     let scene = |n: usize| if n == 0 { &own } else { &scenes[n - 1] };
     let expectations: &[(&str, usize, [Change; 3])] = &[
         ("specular-unnormalized-reflection=2", 1, [Brighter, Same, Same]),
@@ -117,6 +123,7 @@ fn every_fault_changes_what_it_should_and_nothing_else() {
         ("falloff-plus-one", 1, [Darker, Same, Same]),
         ("no-falloff", 1, [Moved, Same, Same]),
         ("directional-flipped", 2, [Darker, Same, Same]),
+        ("point-light-missing", 0, [Darker, Same, Same]),
         ("no-shadows", 7, [Brighter, Same, Same]),
         ("shadow-acne", 7, [Darker, Same, Same]),
         ("shadows-beyond-light", 0, [Darker, Same, Same]),
@@ -136,6 +143,11 @@ fn every_fault_changes_what_it_should_and_nothing_else() {
         ("pixel-mapping=centres", 1, [Moved, Moved, Moved]),
         ("fov-half-angle", 1, [Moved, Moved, Moved]),
         ("up-orthonormalized", 2, [Moved, Moved, Moved]),
+        ("plane-missing", 1, [Darker, Darker, Darker]),
+        ("triangle-missing", 2, [Moved, Darker, Darker]),
+        ("transform-missing", 3, [Moved, Moved, Darker]),
+        ("no-jitter", 8, [Moved, Same, Same]),
+        ("no-filter", 8, [Moved, Same, Same]),
         ("gamma-applied=srgb", 1, [Brighter, Same, Same]),
         ("color-not-clamped", 1, [Darker, Same, Same]),
         ("normals-not-remapped", 1, [Same, Darker, Same]),
@@ -144,6 +156,7 @@ fn every_fault_changes_what_it_should_and_nothing_else() {
         ("depth-miss-white", 3, [Same, Same, Brighter]),
         ("cubemap-face-flipped=vertical", 6, [Moved, Same, Same]),
         ("cubemap-ignored", 6, [Darker, Same, Same]),
+        ("background-missing", 0, [Darker, Same, Same]),
     ];
     let listed: Vec<Fault> = expectations
         .iter()
@@ -151,7 +164,7 @@ fn every_fault_changes_what_it_should_and_nothing_else() {
         .collect();
     assert_eq!(listed, Fault::ALL, "one expectation per fault, in catalogue order");
 
-    let goldens: Vec<[RgbImage; 3]> = (0..=7).map(|n| pictures(scene(n), &FaultSet::NONE)).collect();
+    let goldens: Vec<[RgbImage; 3]> = (0..=8).map(|n| pictures(scene(n), &FaultSet::NONE)).collect();
     let mut failures = Vec::new();
     for &(text, n, expected) in expectations {
         let faults: FaultSet = text.parse().unwrap();
