@@ -40,7 +40,6 @@ fn course(number: usize) -> Case {
         normals: true,
         jitter: sampled,
         filter: sampled,
-        ..AssignmentOptions::default()
     };
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/mit6837").join(file);
     load_assignment_scene(&path, &options).unwrap_or_else(|e| panic!("{e}"))
