@@ -84,9 +84,7 @@ impl Fault {
             | UpOrthonormalized
             | PlaneMissing
             | TriangleMissing
-            | TransformMissing
-            | NoJitter
-            | NoFilter => Pictures::ALL,
+            | TransformMissing => Pictures::ALL,
             NormalsNotRemapped => Pictures::NORMALS,
             DepthInverted | DepthNotClamped | DepthMissWhite => Pictures::DEPTH,
             _ => Pictures::COLOR,
