@@ -15,6 +15,7 @@ pub mod error;
 pub mod fault;
 pub mod film;
 pub mod grade;
+pub mod html_escape;
 pub mod image_size;
 pub mod located_toml;
 pub mod named_enum;

@@ -20,6 +20,7 @@ use super::score::{ImageResult, StudentResult, percent};
 use crate::atomic_write::{replace_file, write_file_atomic};
 use crate::compare::Metrics;
 use crate::film::OutputError;
+pub use crate::html_escape::escape;
 
 const STYLE: &str = r#"
 body{font:14px/1.4 system-ui,sans-serif;margin:1.5em;color:#222;background:#fafafa}
@@ -82,22 +83,6 @@ pub fn write_html(report: &ClassReport, out: &Path) -> Result<(), OutputError> {
         replace_file(&out.join(&student.page), student_page(report, student).as_bytes())?;
     }
     Ok(())
-}
-
-/// Text and attribute values alike: `&`, `<`, `>`, `"` and `'` become entities.
-pub fn escape(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    for c in text.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&#39;"),
-            c => out.push(c),
-        }
-    }
-    out
 }
 
 fn page(title: &str, body: &str) -> String {

@@ -13,6 +13,7 @@ use std::fmt::Write as _;
 
 use super::case_review::CaseReview;
 use crate::compare::{Comparison, Encoding, Verdict};
+pub use crate::html_escape::escape;
 use crate::provenance::Provenance;
 
 const STYLE: &str = include_str!("page.css");
@@ -290,20 +291,4 @@ fn has_channel(review: &CaseReview, name: &str) -> bool {
 
 fn disabled(yes: bool) -> &'static str {
     if yes { " disabled" } else { "" }
-}
-
-/// Text and attribute values alike: `&`, `<`, `>`, `"` and `'` become entities.
-pub fn escape(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    for c in text.chars() {
-        match c {
-            '&' => out.push_str("&amp;"),
-            '<' => out.push_str("&lt;"),
-            '>' => out.push_str("&gt;"),
-            '"' => out.push_str("&quot;"),
-            '\'' => out.push_str("&#39;"),
-            c => out.push(c),
-        }
-    }
-    out
 }
