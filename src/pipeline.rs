@@ -185,7 +185,7 @@ pub fn render_assignment(
 
 /// Load, build, render (with the AOVs when `aovs`) and write with the case's provenance (and the
 /// run's record when `record` asks), timing each phase and counting rays. The commands always
-/// measure: counting costs nothing measurable (`cargo bench -- stats_overhead`), so `--stats`
+/// measure: counting costs nothing measurable (`cargo bench -p goldray-bench -- stats_overhead`), so `--stats`
 /// only decides whether the numbers are shown, and can never change what is rendered.
 fn measured_run(
     load: impl FnOnce() -> Result<Case, Error>,

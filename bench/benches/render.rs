@@ -195,6 +195,7 @@ fn end_to_end(c: &mut Criterion) {
     group.sample_size(10);
     for name in ["spheres_shadows", "blob_mesh"] {
         let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("..")
             .join("cases")
             .join(format!("{name}.toml"));
         group.bench_function(name, |b| {
@@ -219,7 +220,7 @@ const COURSE_COMMANDS: [(&str, (f64, f64), u32, bool); 7] = [
 ];
 
 fn course_scenes(c: &mut Criterion) {
-    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases/mit6837");
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("cases/mit6837");
     let mut group = c.benchmark_group("course_scenes");
     group.sample_size(10);
     group.bench_function("seven_at_800", |b| {
@@ -263,7 +264,7 @@ fn ensure_blob_1m(path: &Path) {
 }
 
 fn stats_overhead(c: &mut Criterion) {
-    let cases = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases");
+    let cases = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("cases");
     ensure_blob_1m(&cases.join("bench/assets/blob_1m.obj"));
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)

@@ -17,7 +17,7 @@ use goldray::pipeline::provenance;
 use goldray::provenance::{Group, strip};
 
 fn provenance_cost(c: &mut Criterion) {
-    let cases = Path::new(env!("CARGO_MANIFEST_DIR")).join("cases");
+    let cases = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("cases");
     let obj = cases.join("bench/assets/blob_1m.obj");
     if !obj.exists() {
         let (positions, triangles) = blob(8, 1);
