@@ -25,6 +25,7 @@ pub mod precision;
 pub mod progress;
 pub mod provenance;
 pub mod review;
+pub mod rgb_image;
 pub mod run;
 pub mod sandbox;
 pub mod simd;

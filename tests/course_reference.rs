@@ -12,7 +12,7 @@ use goldray::case::{AssignmentOptions, load_assignment_scene};
 use goldray::film::{Tonemap, color_image, depth_image, normals_image};
 use goldray::pipeline::render_case;
 use goldray::provenance::{Group, Provenance, keys, strip};
-use image::RgbImage;
+use goldray::rgb_image::RgbImage;
 
 /// The course's scene `file` (e.g. `scene01_plane.txt`).
 fn scene_path(file: &str) -> PathBuf {
@@ -74,9 +74,7 @@ fn check_against_reference(scene: &str, reference: &str, depth_range: (f64, f64)
         ),
     ];
     for (what, ours, file) in images {
-        let expected = image::open(reference_path(&file))
-            .unwrap_or_else(|e| panic!("{file}: {e}"))
-            .into_rgb8();
+        let expected = goldray::rgb_image::read_png(&reference_path(&file)).unwrap_or_else(|e| panic!("{file}: {e}"));
         let (fraction, off) = agreement(&ours, &expected, 2);
         assert!(
             fraction >= 0.995,

@@ -19,13 +19,15 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 use std::time::Instant;
 
+mod util;
+
 use goldray::case::Case;
 use goldray::fault::{Fault, FaultSet};
 use goldray::film::{encode_png, picture_with_faults};
 use goldray::grade::{ClassReport, GradeOptions, StudentResult, UNEXPLAINED, grade_class, load_rubric};
 use goldray::pipeline::{FaultRenderer, fault_applies};
 use goldray::progress::Silent;
-use image::{Rgb, RgbImage};
+use goldray::rgb_image::{Rgb, RgbImage, read_png};
 
 const SIZE: u32 = 100;
 
@@ -183,7 +185,7 @@ fn grade(name: &str, perturbation: Perturbation) -> Graded {
         let folder = submissions.join("noisy");
         write_student(&rubric, &renderers, &FaultSet::NONE, Perturbation::None, &folder);
         for spec in &rubric.images {
-            let picture = image::open(folder.join(&spec.file)).unwrap().into_rgb8();
+            let picture = read_png(&folder.join(&spec.file)).unwrap();
             fs::write(folder.join(&spec.file), encode_png(&noise(&picture, 3)).unwrap()).unwrap();
         }
         made.insert("noisy".to_owned(), FaultSet::NONE);
@@ -203,12 +205,9 @@ fn grade(name: &str, perturbation: Perturbation) -> Graded {
         let reencoded = submissions.join("re-encoded");
         fs::create_dir_all(&reencoded).unwrap();
         for spec in &rubric.images {
-            let picture = image::open(submissions.join("correct").join(&spec.file))
-                .unwrap()
-                .into_rgba8();
-            picture
-                .save_with_format(reencoded.join(&spec.file), image::ImageFormat::Png)
-                .unwrap();
+            let picture = read_png(&submissions.join("correct").join(&spec.file)).unwrap();
+            let rgba = util::png_in_layout(&picture, png::ColorType::Rgba, png::BitDepth::Eight);
+            fs::write(reencoded.join(&spec.file), rgba).unwrap();
         }
         made.insert("re-encoded".to_owned(), FaultSet::NONE);
     }
@@ -778,11 +777,7 @@ fn the_course_references_with_output_mistakes_are_diagnosed() {
     }
     let rubric_path = dir.join("rubric.toml");
     fs::write(&rubric_path, rubric).unwrap();
-    let reference = |file: &str| {
-        image::open(root.join("tests/data/mit6837").join(file))
-            .unwrap()
-            .into_rgb8()
-    };
+    let reference = |file: &str| read_png(&root.join("tests/data/mit6837").join(file)).unwrap();
     let submissions = dir.join("submissions");
     let correct = submissions.join("reference");
     fs::create_dir_all(&correct).unwrap();
@@ -831,15 +826,11 @@ fn the_course_references_with_output_mistakes_are_diagnosed() {
             "normals-not-remapped",
             curve(&reference("a01n.png"), &|c| 2.0 * c - 1.0),
         ),
-        (
-            "a02n.png",
-            "pixel-mapping",
-            image::imageops::flip_vertical(&reference("a02n.png")),
-        ),
+        ("a02n.png", "pixel-mapping", reference("a02n.png").flipped_vertically()),
         (
             "a05n.png",
             "pixel-mapping",
-            image::imageops::flip_horizontal(&reference("a05n.png")),
+            reference("a05n.png").flipped_horizontally(),
         ),
         ("a02d.png", "depth-inverted", {
             let (depth, normals) = (reference("a02d.png"), reference("a02n.png"));
@@ -861,11 +852,7 @@ fn the_course_references_with_output_mistakes_are_diagnosed() {
                 }
             })
         }),
-        (
-            "a05d.png",
-            "pixel-mapping",
-            image::imageops::flip_vertical(&reference("a05d.png")),
-        ),
+        ("a05d.png", "pixel-mapping", reference("a05d.png").flipped_vertically()),
     ];
     let faulty = submissions.join("outputs");
     fs::create_dir_all(&faulty).unwrap();

@@ -12,7 +12,7 @@ use goldray::fault::{Fault, FaultSet};
 use goldray::film::{Film, Picture, Tonemap, picture, picture_with_faults};
 use goldray::pipeline::{fault_applies, render_case, render_case_with_faults};
 use goldray::progress::Silent;
-use image::{RgbImage, imageops};
+use goldray::rgb_image::RgbImage;
 
 const SIZE: u32 = 64;
 
@@ -225,8 +225,8 @@ fn orientation_faults_are_flips_of_the_golden_pictures() {
     let upside_down = pictures(&case, &"pixel-mapping=upside-down".parse().unwrap());
     let mirrored = pictures(&case, &"pixel-mapping=mirrored".parse().unwrap());
     for i in 0..3 {
-        assert!(upside_down[i] == imageops::flip_vertical(&golden[i]), "picture {i}");
-        assert!(mirrored[i] == imageops::flip_horizontal(&golden[i]), "picture {i}");
+        assert!(upside_down[i] == golden[i].flipped_vertically(), "picture {i}");
+        assert!(mirrored[i] == golden[i].flipped_horizontally(), "picture {i}");
     }
 }
 
@@ -258,7 +258,7 @@ fn faults_combine() {
     let golden = pictures(&case, &FaultSet::NONE);
     let no_shadows = pictures(&case, &"no-shadows".parse().unwrap());
     let pair = pictures(&case, &"no-shadows+pixel-mapping=upside-down".parse().unwrap());
-    assert!(pair[0] == imageops::flip_vertical(&no_shadows[0]));
+    assert!(pair[0] == no_shadows[0].flipped_vertically());
     let both = pictures(&case, &"no-shadows+no-reflections".parse().unwrap());
     let reflection = pictures(&case, &"no-reflections".parse().unwrap());
     assert!(both[0] != no_shadows[0] && both[0] != reflection[0] && both[0] != golden[0]);

@@ -250,7 +250,7 @@ fn write_outputs_writes_exactly_the_requested_files_in_order() {
         let found = Provenance::read(file).expect("readable").expect("stamped");
         assert_eq!(found, provenance, "{}", file.display());
     }
-    let png = image::open(&expected[1]).expect("png").to_rgb8();
+    let png = goldray::rgb_image::read_png(&expected[1]).expect("png");
     assert_eq!(png, goldray::film::color_image(&film, Tonemap::Srgb));
 
     let bare = OutputOptions {

@@ -445,7 +445,7 @@ fn list_accept_reject_and_accept_all_from_the_command_line() {
 
 /// Pixels of the red-to-yellow heat scale or the failing magenta: what tells a reviewer where
 /// the pictures differ.
-fn heat_pixels(shot: &image::RgbImage) -> usize {
+fn heat_pixels(shot: &goldray::rgb_image::RgbImage) -> usize {
     shot.pixels()
         .filter(|p| {
             let [r, g, b] = p.0;

@@ -13,8 +13,8 @@ use goldray::options::{Precision, Spawn};
 use goldray::pipeline::render_options;
 use goldray::progress::Silent;
 use goldray::real::Vec3;
+use goldray::rgb_image::RgbImage;
 use goldray::with_precision;
-use image::RgbImage;
 
 /// The classic assignment's `tmin`.
 const ASSIGNMENT_EPSILON: f64 = 1.0e-4;
@@ -162,7 +162,7 @@ fn agreement(precision: Precision, spawn: Spawn, placements: &[(String, Placemen
             );
             if fraction < 0.999 {
                 let name = format!("goldray-scale-{}-{spawn:?}-{label}.png", precision.name()).replace(' ', "_");
-                image.save(std::env::temp_dir().join(name)).unwrap();
+                goldray::film::write_png(&std::env::temp_dir().join(name), &image).unwrap();
             }
             (label.clone(), fraction)
         })

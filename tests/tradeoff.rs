@@ -333,9 +333,9 @@ fn the_report_reads_back_with_every_setting_and_the_plot_decodes() {
     );
     assert!(markdown.contains("](tradeoff.png)"));
 
-    let plot = image::open(out.join(PLOT_FILE)).unwrap();
+    let plot = util::read_png(&out.join(PLOT_FILE));
     assert_eq!((plot.width(), plot.height()), (PLOT_WIDTH, PLOT_HEIGHT));
-    let colours: std::collections::HashSet<_> = plot.to_rgb8().pixels().map(|p| p.0).collect();
+    let colours: std::collections::HashSet<_> = plot.pixels().map(|p| p.0).collect();
     assert!(
         colours.len() > 20,
         "the plot has curves, text and a legend, not a blank page"

@@ -25,7 +25,7 @@ use std::time::{Duration, Instant};
 
 use clap::Parser;
 use goldray::case::AssignmentOptions;
-use image::RgbImage;
+use goldray::rgb_image::RgbImage;
 
 #[derive(Parser)]
 #[command(about = "Render random course scenes with goldray and the course binary and compare the images")]
@@ -418,9 +418,7 @@ fn wait_with_timeout(mut cmd: Command, limit: Duration) -> Result<std::process::
 }
 
 fn load(path: &Path) -> Result<RgbImage, String> {
-    Ok(image::open(path)
-        .map_err(|e| format!("{}: {e}", path.display()))?
-        .into_rgb8())
+    goldray::rgb_image::read_png(path).map_err(|e| e.to_string())
 }
 
 /// The verdict and the differing pixels.

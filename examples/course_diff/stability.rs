@@ -10,7 +10,7 @@ use std::path::Path;
 use goldray::case::{AssignmentOptions, parse_assignment_scene};
 use goldray::film::{Tonemap, color_image, depth_image, normals_image};
 use goldray::pipeline::render_case;
-use image::RgbImage;
+use goldray::rgb_image::RgbImage;
 
 /// The camera moves this fraction of its distance along each axis, both ways.
 const NUDGE: f64 = 1e-5;

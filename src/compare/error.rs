@@ -33,7 +33,7 @@ pub enum CompareError {
     Png {
         path: PathBuf,
         #[source]
-        source: image::ImageError,
+        source: crate::rgb_image::DecodeError,
     },
 
     #[error("{} is neither an EXR nor a PNG (its first bytes match neither signature)", path.display())]

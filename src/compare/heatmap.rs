@@ -12,7 +12,7 @@
 //! ([`evidence_heatmap`]): each pixel's largest |z| on the same red–yellow scale, linear from
 //! |z| = 1 (what noise gives most of the time) to the Šidák threshold, magenta beyond it.
 
-use image::{Rgb, RgbImage};
+use crate::rgb_image::{Rgb, RgbImage};
 
 use super::comparison::Comparison;
 use super::image::{COLOR_CHANNELS, Image};
@@ -143,7 +143,7 @@ pub fn evidence_heatmap(expected: &Image, actual: &Image, noise: &Noise, pixel_t
 }
 
 /// The expected image as dim grey.
-fn backdrop(expected: &Image, x: u32, y: u32) -> Rgb<u8> {
+fn backdrop(expected: &Image, x: u32, y: u32) -> Rgb {
     Rgb([grey(expected, x, y) as u8; 3])
 }
 
@@ -153,7 +153,7 @@ fn grey(expected: &Image, x: u32, y: u32) -> f32 {
 }
 
 /// The red–yellow scale at `t` in [0, 1], over the backdrop.
-fn hot(expected: &Image, x: u32, y: u32, t: f32) -> Rgb<u8> {
+fn hot(expected: &Image, x: u32, y: u32, t: f32) -> Rgb {
     let grey = grey(expected, x, y);
     let hot = [255.0, 40.0 + 215.0 * t, 0.0];
     let weight = 0.4 + 0.6 * t;

@@ -5,12 +5,16 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 use ::exr::meta::MetaData;
-use image::RgbImage;
 use serde::{Deserialize, Serialize};
 
 use super::error::CompareError;
 use super::flip::Reference;
 use crate::film::{Film, Tonemap, color_image, decode_exr};
+use crate::rgb_image::{RgbImage, decode_png};
+
+/// The most memory a decoded PNG may take: 512 MiB, the limit the `image` crate set by default
+/// when it decoded these files, far above any picture goldray compares.
+const MAX_DECODED_BYTES: u64 = 512 << 20;
 
 /// The EXR channels goldray writes and reads, in the contract's order. Other channels in a file
 /// are not compared, because the film reader does not decode them.
@@ -124,12 +128,11 @@ impl Image {
 
     pub fn from_png_bytes(bytes: &[u8], source: impl Into<PathBuf>) -> Result<Image, CompareError> {
         let source = source.into();
-        let decoded =
-            image::load_from_memory_with_format(bytes, image::ImageFormat::Png).map_err(|e| CompareError::Png {
-                path: source.clone(),
-                source: e,
-            })?;
-        Ok(Image::from_rgb8(decoded.into_rgb8(), source))
+        let decoded = decode_png(bytes, MAX_DECODED_BYTES).map_err(|e| CompareError::Png {
+            path: source.clone(),
+            source: e,
+        })?;
+        Ok(Image::from_rgb8(decoded.image, source))
     }
 
     /// Decides EXR or PNG by the file's signature, not its name, so that a misnamed file is read

@@ -47,7 +47,7 @@ pub enum OutputError {
     EncodeExr { file: String, source: ::exr::error::Error },
 
     #[error("cannot encode {file}: {source}")]
-    EncodePng { file: String, source: image::ImageError },
+    EncodePng { file: String, source: png::EncodingError },
 
     #[error("{file} is not a readable EXR: {source}")]
     DecodeExr { file: String, source: ::exr::error::Error },

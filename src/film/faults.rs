@@ -4,7 +4,7 @@
 //!
 //! [`Injection::Output`]: crate::fault::Injection::Output
 
-use image::{Rgb, RgbImage, imageops};
+use crate::rgb_image::{Rgb, RgbImage};
 use serde::Serialize;
 
 use super::png::{color_image, depth_image, normals_image, quantised_image};
@@ -112,8 +112,8 @@ fn wrapped_image(film: &Film, value: impl Fn(usize) -> [f32; 3]) -> RgbImage {
 /// `pixel-mapping=upside-down` and `=mirrored`.
 fn orient(mut image: RgbImage, faults: &FaultSet) -> RgbImage {
     match faults.mapping() {
-        Some(Mapping::UpsideDown) => imageops::flip_vertical_in_place(&mut image),
-        Some(Mapping::Mirrored) => imageops::flip_horizontal_in_place(&mut image),
+        Some(Mapping::UpsideDown) => image.flip_vertically(),
+        Some(Mapping::Mirrored) => image.flip_horizontally(),
         Some(Mapping::Centres) | None => {}
     }
     image

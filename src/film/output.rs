@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use image::RgbImage;
+use crate::rgb_image::RgbImage;
 use rayon::prelude::*;
 
 use super::error::OutputError;

@@ -4,13 +4,12 @@
 
 use std::path::Path;
 
-use image::error::{EncodingError, ImageFormatHint};
-use image::{ImageError, ImageFormat, RgbImage};
 use rayon::prelude::*;
 
 use super::error::OutputError;
 use super::{Film, Tonemap};
 use crate::atomic_write::write_file_atomic;
+use crate::rgb_image::RgbImage;
 
 /// Colour as the case asks: `Srgb` for viewing, `Clamp` for the assignment's `trunc(c·255)`.
 pub fn color_image(film: &Film, tonemap: Tonemap) -> RgbImage {
@@ -227,7 +226,7 @@ pub fn write_png(path: &Path, image: &RgbImage) -> Result<(), OutputError> {
 pub(super) fn encode_png_named(image: &RgbImage, file: &str) -> Result<Vec<u8>, OutputError> {
     let fail = |error: png::EncodingError| OutputError::EncodePng {
         file: file.to_owned(),
-        source: ImageError::Encoding(EncodingError::new(ImageFormatHint::Exact(ImageFormat::Png), error)),
+        source: error,
     };
     let mut bytes = Vec::with_capacity(image.as_raw().len() / 4 + 1024);
     let mut encoder = png::Encoder::new(&mut bytes, image.width(), image.height());

@@ -40,7 +40,7 @@ use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 
-use image::RgbImage;
+use crate::rgb_image::RgbImage;
 
 use super::diagnosis::{
     Closest, Confidence, Diagnosis, DiagnosisRun, RenderDiagnosis, Residual, UNEXPLAINED, Unfinished, UnfinishedPart,

@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
-use image::RgbImage;
+use crate::rgb_image::RgbImage;
 use serde::{Deserialize, Serialize};
 
 use super::error::GradeError;

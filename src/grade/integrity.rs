@@ -10,7 +10,7 @@ use std::collections::HashMap;
 use std::fs;
 use std::path::{Path, PathBuf};
 
-use image::RgbImage;
+use crate::rgb_image::RgbImage;
 
 use super::error::RubricError;
 use super::submission::read_png;

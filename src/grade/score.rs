@@ -4,9 +4,6 @@
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use fast_image_resize::images::{TypedImage, TypedImageRef};
-use fast_image_resize::pixels::U8x3;
-use fast_image_resize::{FilterType, ResizeAlg, ResizeOptions, Resizer};
 use serde::{Deserialize, Serialize};
 
 use super::diagnosis::{Diagnosis, Unfinished};
@@ -22,6 +19,7 @@ use super::timing::{Timings, seconds, timed};
 use crate::atomic_write::replace_file;
 use crate::compare::{Encoding, Image, Metrics, Tolerance, compare_timed, diff_heatmap, diff_heatmap_widened};
 use crate::film::{OutputError, encode_png};
+use crate::rgb_image::RgbImage;
 use crate::sandbox::RunRecord;
 
 /// One expected file of one student.
@@ -356,32 +354,14 @@ pub const THUMBNAILS_DIR: &str = "thumbnails";
 const THUMBNAIL: u32 = 300;
 
 /// `picture` shrunk (never enlarged) to fit a [`THUMBNAIL`] square, keeping its aspect.
-fn thumbnail(picture: &image::RgbImage) -> image::RgbImage {
+fn thumbnail(picture: &RgbImage) -> RgbImage {
     let (width, height) = picture.dimensions();
     let longest = width.max(height);
     if longest <= THUMBNAIL {
         return picture.clone();
     }
     let scale = |side: u32| ((u64::from(side) * u64::from(THUMBNAIL)) / u64::from(longest)).max(1) as u32;
-    let mut small = image::RgbImage::new(scale(width), scale(height));
-    let (small_width, small_height) = small.dimensions();
-    let area_average = ResizeOptions::new().resize_alg(ResizeAlg::Convolution(FilterType::Box));
-    // Typed as 8-bit RGB: the untyped `Resizer::resize` would compile the resizer for every pixel
-    // type it knows (a third of this crate's code before optimisation) to use one.
-    let resized = TypedImageRef::<U8x3>::from_buffer(width, height, picture.as_raw())
-        .map_err(|_| ())
-        .and_then(|source| {
-            let mut target = TypedImage::<U8x3>::from_buffer(small_width, small_height, &mut small).map_err(|_| ())?;
-            Resizer::new()
-                .resize_typed(&source, &mut target, &area_average)
-                .map_err(|_| ())
-        });
-    match resized {
-        Ok(()) => small,
-        // Both are 8-bit RGB buffers of their sizes, which the resizer takes; should it refuse
-        // one anyway, the report still gets a thumbnail.
-        Err(()) => image::imageops::thumbnail(picture, small_width, small_height),
-    }
+    picture.shrunk(scale(width), scale(height))
 }
 
 /// A result with nothing compared: no points, and the outcome's reason as the explanation.

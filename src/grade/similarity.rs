@@ -13,7 +13,7 @@
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 use std::path::Path;
 
-use image::RgbImage;
+use crate::rgb_image::RgbImage;
 use serde::{Deserialize, Serialize};
 
 use super::integrity::pixel_hash;
@@ -169,7 +169,7 @@ mod tests {
     use std::path::PathBuf;
 
     use super::*;
-    use image::Rgb;
+    use crate::rgb_image::Rgb;
 
     fn picture(seed: u32, changed: u32) -> RgbImage {
         let mut picture = RgbImage::from_fn(100, 100, |x, y| Rgb([(x * 2) as u8, (y * 2) as u8, seed as u8]));
@@ -186,7 +186,7 @@ mod tests {
             .iter()
             .map(|(name, picture)| {
                 let path = dir.path().join(format!("{name}.png"));
-                picture.save(&path).unwrap();
+                crate::film::write_png(&path, picture).unwrap();
                 (*name, path, Fingerprint::of(picture, true))
             })
             .collect();

@@ -13,13 +13,11 @@
 use std::collections::BTreeMap;
 use std::fs::{self, File};
 use std::hash::{Hash, Hasher};
-use std::io::{Cursor, Read};
+use std::io::Read;
 use std::path::{Path, PathBuf};
 
-use image::codecs::png::PngDecoder;
-use image::{ColorType, DynamicImage, ImageDecoder, ImageError, Limits, RgbImage};
-
 use super::outcome::Outcome;
+use crate::rgb_image::{DecodeError, RgbImage, decode_png};
 
 /// The largest file read at all: a 16-bit RGBA PNG of a 4096² image stored uncompressed is
 /// 128 MiB, far beyond any honest submission.
@@ -251,57 +249,54 @@ pub fn read_png(path: &Path) -> Result<Submitted, Outcome> {
 }
 
 fn decode(bytes: &[u8]) -> Result<(RgbImage, Vec<String>), Outcome> {
-    let mut limits = Limits::default();
-    limits.max_image_width = Some(MAX_SIDE);
-    limits.max_image_height = Some(MAX_SIDE);
-    limits.max_alloc = Some(MAX_DECODE_BYTES);
-    let decoder = PngDecoder::with_limits(Cursor::new(bytes), limits).map_err(decode_failure)?;
-    if decoder.total_bytes() > MAX_DECODE_BYTES {
-        let (width, height) = decoder.dimensions();
-        return Err(Outcome::TooLarge {
-            reason: format!(
-                "the PNG declares {width}×{height} pixels of {:?}, {} MiB decoded (a decompression bomb?); \
-                 nothing over {} MiB is decoded",
-                decoder.color_type(),
-                decoder.total_bytes() >> 20,
-                MAX_DECODE_BYTES >> 20
-            ),
+    let decoded = decode_png(bytes, MAX_DECODE_BYTES).map_err(decode_failure)?;
+    let layout = decoded.layout;
+    let mut notes = Vec::new();
+    if layout.is_grey() && !layout.has_alpha() {
+        notes.push("grey PNG: compared as RGB with equal channels".to_owned());
+    }
+    if layout.has_alpha() {
+        notes.push(match decoded.translucent {
+            0 => "PNG with alpha: alpha ignored (every pixel is opaque)".to_owned(),
+            n => {
+                format!("PNG with alpha: alpha ignored ({n} pixels are not opaque; their colour is compared as stored)")
+            }
         });
     }
-    let color = decoder.color_type();
-    let decoded = DynamicImage::from_decoder(decoder).map_err(decode_failure)?;
-    let mut notes = Vec::new();
-    match color {
-        ColorType::Rgb8 | ColorType::Rgb16 => {}
-        ColorType::L8 | ColorType::L16 => notes.push("grey PNG: compared as RGB with equal channels".to_owned()),
-        ColorType::La8 | ColorType::La16 | ColorType::Rgba8 | ColorType::Rgba16 => {
-            let translucent = decoded.to_rgba8().pixels().filter(|p| p.0[3] != 255).count();
-            notes.push(match translucent {
-                0 => "PNG with alpha: alpha ignored (every pixel is opaque)".to_owned(),
-                n => format!(
-                    "PNG with alpha: alpha ignored ({n} pixels are not opaque; their colour is compared as stored)"
-                ),
-            });
-        }
-        other => notes.push(format!("{other:?} PNG: converted to 8-bit RGB")),
-    }
-    if color.bytes_per_pixel() / color.channel_count() == 2 {
+    if layout.bits == 16 {
         notes.push("16-bit PNG: rounded to 8 bits per channel".to_owned());
     }
-    Ok((decoded.into_rgb8(), notes))
+    Ok((decoded.image, notes))
 }
 
 /// The decoder's errors, sorted into what a TA needs to know.
-fn decode_failure(error: ImageError) -> Outcome {
+fn decode_failure(error: DecodeError) -> Outcome {
     match error {
-        ImageError::Limits(e) => Outcome::TooLarge {
-            reason: format!("decoding would exceed the memory limit: {e}"),
+        DecodeError::TooLarge {
+            width,
+            height,
+            layout,
+            bytes,
+            limit,
+        } => Outcome::TooLarge {
+            reason: format!(
+                "the PNG declares {width}×{height} pixels of {layout}, {} MiB decoded (a decompression bomb?); \
+                 nothing over {} MiB is decoded",
+                bytes >> 20,
+                limit >> 20
+            ),
         },
-        ImageError::IoError(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => Outcome::Unreadable {
+        DecodeError::OverMemoryLimit => Outcome::TooLarge {
+            reason: "decoding would exceed the memory limit".to_owned(),
+        },
+        DecodeError::Truncated => Outcome::Unreadable {
             reason: "truncated PNG: the file ends before the image data does".to_owned(),
         },
-        other => Outcome::Unreadable {
-            reason: format!("corrupt PNG: {other}"),
+        DecodeError::Read { source, .. } => Outcome::Unreadable {
+            reason: format!("cannot read the file: {source}"),
+        },
+        DecodeError::Corrupt(e) => Outcome::Unreadable {
+            reason: format!("corrupt PNG: {e}"),
         },
     }
 }

@@ -10,7 +10,7 @@
 
 use std::path::Path;
 
-use image::RgbImage;
+use crate::rgb_image::RgbImage;
 
 use super::error::ReviewError;
 use super::pending::{Pending, Project, relative};

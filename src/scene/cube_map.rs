@@ -5,11 +5,11 @@
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-use image::ImageFormat;
 use rayon::prelude::*;
 
 use super::real::{Color, Real, Vec3};
 pub use crate::build_error::CubeMapError;
+use crate::rgb_image::decode_png;
 use crate::simd::Isa;
 
 /// One face: a PNG read and checked at load, decoded when a ray first looks at it.
@@ -34,6 +34,10 @@ pub struct CubeMap {
     /// In the order of `FACE_NAMES`.
     faces: [Face; 6],
 }
+
+/// The most memory a face other than 8-bit RGB may take while it is converted: 512 MiB, the
+/// limit the `image` crate set by default when it converted faces.
+const MAX_FACE_BYTES: u64 = 512 << 20;
 
 const FACE_NAMES: [&str; 6] = ["right", "left", "up", "down", "front", "back"];
 const RIGHT: usize = 0;
@@ -135,8 +139,8 @@ impl Face {
         let error = |reason: String| CubeMapError { path: path.clone(), reason };
         let png = std::fs::read(&path).map_err(|e| error(e.to_string()))?;
         check_chunks(&png).map_err(|reason| error(format!("not a valid PNG file: {reason}")))?;
-        let reader = image::ImageReader::with_format(std::io::Cursor::new(&png), ImageFormat::Png);
-        let (width, height) = reader.into_dimensions().map_err(|e| error(e.to_string()))?;
+        let header = png::Decoder::new(std::io::Cursor::new(&png)).read_info().map_err(|e| error(e.to_string()))?;
+        let (width, height) = (header.info().width, header.info().height);
         if width == 0 || height == 0 {
             return Err(error("the image is empty".to_string()));
         }
@@ -215,14 +219,14 @@ struct Spot {
 
 /// A face's texels as RGB bytes. An 8-bit RGB PNG (the course's faces) is decoded by the `png`
 /// crate straight into the buffer the texels are kept in, without the chunks' CRCs, which
-/// [`check_chunks`] verified at load; any other PNG is converted by `image`.
+/// [`check_chunks`] verified at load; any other PNG is converted to 8-bit RGB by [`decode_png`].
 fn decode_rgb8(png: &[u8]) -> Result<Vec<u8>, String> {
     let mut decoder = png::Decoder::new(std::io::Cursor::new(png));
     decoder.ignore_checksums(true);
     let mut reader = decoder.read_info().map_err(|e| e.to_string())?;
     if reader.output_color_type() != (png::ColorType::Rgb, png::BitDepth::Eight) {
-        let image = image::load_from_memory_with_format(png, ImageFormat::Png).map_err(|e| e.to_string())?;
-        return Ok(image.into_rgb8().into_raw());
+        let decoded = decode_png(png, MAX_FACE_BYTES).map_err(|e| e.to_string())?;
+        return Ok(decoded.image.into_raw());
     }
     let size = reader.output_buffer_size().ok_or("the image is too large")?;
     let mut texels = vec![0; size];
@@ -326,9 +330,12 @@ mod tests {
     /// chunk's length and CRC made to match, so that only decoding can tell).
     fn faces_with_a_damaged_right_face(fix_crc: bool) -> tempfile::TempDir {
         let dir = tempfile::tempdir().unwrap();
+        let mut face = Vec::new();
+        let mut encoder = png::Encoder::new(&mut face, 2, 2);
+        encoder.set_color(png::ColorType::Rgb);
+        encoder.write_header().unwrap().write_image_data(&[200, 100, 50].repeat(4)).unwrap();
         for name in FACE_NAMES {
-            let image = image::RgbImage::from_pixel(2, 2, image::Rgb([200, 100, 50]));
-            image.save(dir.path().join(format!("{name}.png"))).unwrap();
+            std::fs::write(dir.path().join(format!("{name}.png")), &face).unwrap();
         }
         let path = dir.path().join("right.png");
         let png = std::fs::read(&path).unwrap();

@@ -348,7 +348,7 @@ mod tests {
     fn our_png_is_recognised_and_others_are_not() {
         let bytes = encode(&vec![0; (WIDTH * HEIGHT * 3) as usize]).unwrap();
         assert!(is_our_png(&bytes));
-        let other = crate::film::encode_png(&image::RgbImage::new(4, 4)).unwrap();
+        let other = crate::film::encode_png(&crate::rgb_image::RgbImage::new(4, 4)).unwrap();
         assert!(!is_our_png(&other));
         assert!(!is_our_png(b"not a png"));
     }

@@ -134,7 +134,7 @@ fn diff_writes_a_heatmap_and_json_on_request() {
     assert_eq!(report["breaches"][0]["limit"], "fail_fraction");
     assert!(report["metrics"]["rmse"].as_f64().is_some_and(|rmse| rmse > 0.002));
     assert!(report["metrics"]["flip"].as_f64().is_some_and(|flip| flip > 0.0));
-    let picture = image::open(&heatmap).expect("the heatmap is a PNG").into_rgb8();
+    let picture = goldray::rgb_image::read_png(&heatmap).expect("the heatmap is a PNG");
     assert_eq!(picture.dimensions(), (200, 200));
     assert!(picture.pixels().any(|p| p.0 == FAILING), "failing pixels are marked");
 }

@@ -93,7 +93,7 @@ pub fn dump_dom_at(page: &Path, width: u32, height: u32) -> String {
 }
 
 /// A screenshot of the page in a `width`×`height` window.
-pub fn screenshot(page: &Path, width: u32, height: u32, file: &Path) -> image::RgbImage {
+pub fn screenshot(page: &Path, width: u32, height: u32, file: &Path) -> goldray::rgb_image::RgbImage {
     run(
         page,
         &[
@@ -102,9 +102,7 @@ pub fn screenshot(page: &Path, width: u32, height: u32, file: &Path) -> image::R
             format!("--screenshot={}", file.display()),
         ],
     );
-    image::open(file)
-        .unwrap_or_else(|e| panic!("{}: {e}", file.display()))
-        .into_rgb8()
+    goldray::rgb_image::read_png(file).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// [`dump_dom_at`] of a page served at `url`.

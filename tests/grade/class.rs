@@ -8,7 +8,9 @@ use std::path::{Path, PathBuf};
 use goldray::case::{Case, LoadOptions, load};
 use goldray::film::{Film, Tonemap, color_image, depth_image, encode_exr, encode_png, normals_image};
 use goldray::pipeline::render_case;
-use image::{DynamicImage, Rgb, RgbImage};
+use goldray::rgb_image::{Rgb, RgbImage};
+
+use crate::util::png_in_layout;
 
 pub const FILES: [&str; 3] = ["color.png", "normals.png", "depth.png"];
 /// Colour counts double, like the shipped rubric.
@@ -85,12 +87,6 @@ pub fn pictures(film: &Film) -> [RgbImage; 3] {
 
 fn png(picture: &RgbImage) -> Vec<u8> {
     encode_png(picture).unwrap()
-}
-
-fn encoded(picture: DynamicImage) -> Vec<u8> {
-    let mut bytes = std::io::Cursor::new(Vec::new());
-    picture.write_to(&mut bytes, image::ImageFormat::Png).unwrap();
-    bytes.into_inner()
 }
 
 /// Deterministic noise of up to ±`amplitude` codes per pixel, under the 8-code threshold: only
@@ -207,9 +203,9 @@ pub fn make_class_at(dir: &Path) -> Class {
     students.push((
         "formats",
         all([
-            encoded(DynamicImage::ImageRgb8(perfect[0].clone()).to_rgba8().into()),
-            encoded(DynamicImage::ImageRgb8(perfect[1].clone()).to_rgb16().into()),
-            encoded(DynamicImage::ImageRgb8(perfect[2].clone()).to_luma8().into()),
+            png_in_layout(&perfect[0], png::ColorType::Rgba, png::BitDepth::Eight),
+            png_in_layout(&perfect[1], png::ColorType::Rgb, png::BitDepth::Sixteen),
+            png_in_layout(&perfect[2], png::ColorType::Grayscale, png::BitDepth::Eight),
         ]),
     ));
 

@@ -8,7 +8,7 @@ use std::path::{Path, PathBuf};
 
 use goldray::grade::{ClassReport, GradeOptions, Outcome, PUBLISHED_COPY, SimilarPair, grade_class};
 use goldray::progress::Silent;
-use image::{Rgb, RgbImage};
+use goldray::rgb_image::{Rgb, RgbImage};
 
 use crate::chromium;
 use crate::class::{FILES, case, pictures, render, rubric_text, scene_path};
@@ -37,7 +37,7 @@ impl Fixture {
         });
         fs::create_dir_all(dir.path().join("published")).unwrap();
         for (file, picture) in FILES.iter().zip(&published) {
-            picture.save(dir.path().join("published").join(file)).unwrap();
+            goldray::film::write_png(&dir.path().join("published").join(file), picture).unwrap();
         }
         fs::create_dir_all(dir.path().join("submissions")).unwrap();
         Fixture { dir, golden, published }
@@ -52,7 +52,7 @@ impl Fixture {
     fn hand_in(&self, name: &str, pictures: &[RgbImage; 3]) {
         let folder = self.student(name);
         for (file, picture) in FILES.iter().zip(pictures) {
-            picture.save(folder.join(file)).unwrap();
+            goldray::film::write_png(&folder.join(file), picture).unwrap();
         }
     }
 
@@ -127,7 +127,7 @@ fn links_inside_the_folder_are_read_by_default_and_refused_when_the_rubric_says_
         let folder = fixture.student("archiver");
         fs::create_dir_all(folder.join("renders")).unwrap();
         for (file, picture) in FILES.iter().zip(&fixture.golden) {
-            picture.save(folder.join("renders").join(file)).unwrap();
+            goldray::film::write_png(&folder.join("renders").join(file), picture).unwrap();
             symlink(Path::new("renders").join(file), folder.join(file)).unwrap();
         }
         let (report, _) = fixture.grade();

@@ -9,7 +9,7 @@ use std::path::{Path, PathBuf};
 
 use goldray::grade::{ClassReport, GradeOptions, Layout, Outcome, Shard, grade_class, merge_shards};
 use goldray::progress::Silent;
-use image::{Rgb, RgbImage};
+use goldray::rgb_image::{Rgb, RgbImage};
 use zip::ZipWriter;
 use zip::write::SimpleFileOptions;
 

@@ -7,7 +7,7 @@ use std::path::Path;
 use std::process::Command;
 
 use goldray::film::{Tonemap, color_image, encode_png};
-use image::Rgb;
+use goldray::rgb_image::Rgb;
 
 use super::class::{case, render, scene_path};
 

@@ -54,7 +54,9 @@ fn a_cpp_submission_is_built_and_run_and_only_the_rubrics_files_come_out() {
         assert!(ran.stdout_tail.contains("rendered data/scene0"), "{}", ran.stdout_tail);
         for file in &super::command(&record, name).outputs {
             assert!(file.delivered, "{file:?}");
-            let dims = image::image_dimensions(out.join(&file.file)).expect("a PNG");
+            let dims = goldray::rgb_image::read_png(&out.join(&file.file))
+                .expect("a PNG")
+                .dimensions();
             assert_eq!(dims, size, "{}", file.file);
         }
     }

@@ -42,3 +42,38 @@ pub fn render_on_threads(case: &Path, out: &Path, threads: &str, extra: &[&str])
     let result = goldray(&args);
     assert!(result.status.success(), "{case}: {}", stderr(&result));
 }
+
+/// `picture` encoded as a PNG of another colour type and bit depth than goldray writes (RGBA,
+/// 16-bit RGB, grey, …), with another compression and filter: what other programs hand in.
+pub fn png_in_layout(picture: &goldray::rgb_image::RgbImage, color: png::ColorType, depth: png::BitDepth) -> Vec<u8> {
+    let samples: Vec<u16> = picture
+        .pixels()
+        .flat_map(|p| {
+            let [r, g, b] = p.0.map(u16::from);
+            let grey = (r + g + b) / 3;
+            match color {
+                png::ColorType::Grayscale => vec![grey],
+                png::ColorType::GrayscaleAlpha => vec![grey, 255],
+                png::ColorType::Rgba => vec![r, g, b, 255],
+                _ => vec![r, g, b],
+            }
+        })
+        .collect();
+    let data: Vec<u8> = match depth {
+        png::BitDepth::Sixteen => samples.iter().flat_map(|&v| (v * 257).to_be_bytes()).collect(),
+        _ => samples.iter().map(|&v| v as u8).collect(),
+    };
+    let mut bytes = Vec::new();
+    let mut encoder = png::Encoder::new(&mut bytes, picture.width(), picture.height());
+    encoder.set_color(color);
+    encoder.set_depth(depth);
+    encoder.set_compression(png::Compression::High);
+    encoder.set_filter(png::Filter::Paeth);
+    encoder.write_header().unwrap().write_image_data(&data).unwrap();
+    bytes
+}
+
+/// A PNG file as 8-bit RGB, which must decode.
+pub fn read_png(path: &Path) -> goldray::rgb_image::RgbImage {
+    goldray::rgb_image::read_png(path).unwrap_or_else(|e| panic!("{e}"))
+}

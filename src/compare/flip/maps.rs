@@ -5,7 +5,7 @@
 use std::cell::RefCell;
 use std::ops::Range;
 
-use image::RgbImage;
+use crate::rgb_image::RgbImage;
 
 use super::color::{color_error, feature_input, flip_error, perceived, srgb_to_ycxcz, strengths};
 use super::kernels::KERNELS;

@@ -19,7 +19,7 @@ mod sparse;
 
 use std::sync::OnceLock;
 
-use image::RgbImage;
+use crate::rgb_image::RgbImage;
 
 use maps::Maps;
 pub(super) use maps::Reference;
@@ -85,7 +85,7 @@ fn dense_error_sum(reference: &Reference, test: &Maps) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use image::Rgb;
+    use crate::rgb_image::Rgb;
 
     fn noise(width: u32, height: u32, seed: u64) -> RgbImage {
         let mut state = seed;

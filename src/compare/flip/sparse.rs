@@ -3,7 +3,7 @@
 //! pixel adds its kernels' weights to the pixels in its reach, and only those pixels are
 //! measured. The cost follows the number of differing pixels, not the picture's size.
 
-use image::RgbImage;
+use crate::rgb_image::RgbImage;
 
 use super::color::{feature_input, srgb_to_ycxcz};
 use super::kernels::{KERNELS, clamped_weight};

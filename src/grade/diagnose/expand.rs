@@ -13,7 +13,7 @@ use super::*;
 /// threshold of it.
 pub(super) fn fit_background(subject: &Subject, misses: &[bool], singles: &[Candidate]) -> Option<FaultSet> {
     let tried = singles.iter().any(|c| c.set.contains(Fault::CubemapIgnored));
-    if !tried || subject.golden.len() != misses.len() * 3 {
+    if !tried || subject.golden.as_raw().len() != misses.len() * 3 {
         return None;
     }
     let seen: Vec<[u8; 3]> = subject
@@ -97,8 +97,8 @@ pub(super) fn expansions(
 pub(super) fn predict(a: &RgbImage, a_set: &FaultSet, b: &RgbImage, b_set: &FaultSet, golden: &RgbImage) -> RgbImage {
     use crate::fault::Mapping;
     let flip = |image: &RgbImage, mapping: Option<Mapping>| match mapping {
-        Some(Mapping::UpsideDown) => image::imageops::flip_vertical(image),
-        Some(Mapping::Mirrored) => image::imageops::flip_horizontal(image),
+        Some(Mapping::UpsideDown) => image.flipped_vertically(),
+        Some(Mapping::Mirrored) => image.flipped_horizontally(),
         _ => image.clone(),
     };
     let b_flip = b_set.mapping().filter(|m| *m != Mapping::Centres);

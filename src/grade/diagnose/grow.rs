@@ -265,14 +265,14 @@ pub(super) fn has_evidence(base: &RgbImage, grown: &RgbImage, student: &RgbImage
 }
 
 /// The largest channel difference, in codes.
-fn distance(a: &image::Rgb<u8>, b: &image::Rgb<u8>) -> f64 {
+fn distance(a: &crate::rgb_image::Rgb, b: &crate::rgb_image::Rgb) -> f64 {
     a.0.iter()
         .zip(b.0)
         .map(|(x, y)| f64::from(x.abs_diff(y)))
         .fold(0.0, f64::max)
 }
 
-fn close(a: &image::Rgb<u8>, b: &image::Rgb<u8>, threshold: f64) -> bool {
+fn close(a: &crate::rgb_image::Rgb, b: &crate::rgb_image::Rgb, threshold: f64) -> bool {
     a.0.iter().zip(b.0).all(|(x, y)| f64::from(x.abs_diff(y)) <= threshold)
 }
 

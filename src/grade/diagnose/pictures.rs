@@ -11,14 +11,13 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
-use image::RgbImage;
-
 use super::super::golden::CacheMode;
 use crate::atomic_write::write_file_atomic;
 use crate::case::Case;
 use crate::fault::FaultSet;
 use crate::film::{Film, Picture, Tonemap, encode_png, picture_with_faults};
 use crate::pipeline::FaultRenderer;
+use crate::rgb_image::{RgbImage, decode_png};
 
 /// How many rendered films are kept for pairing with PNG faults.
 const KEPT_FILMS: usize = 6;
@@ -184,9 +183,7 @@ impl<'a> FaultPictures<'a> {
             .iter()
             .map(|p| {
                 let bytes = fs::read(self.entry(label, *p)?).ok()?;
-                let picture = image::load_from_memory_with_format(&bytes, image::ImageFormat::Png)
-                    .ok()?
-                    .into_rgb8();
+                let picture = decode_png(&bytes, 3 * u64::from(width) * u64::from(height)).ok()?.image;
                 (picture.dimensions() == (width, height)).then_some(picture)
             })
             .collect()

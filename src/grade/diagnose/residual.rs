@@ -4,7 +4,7 @@
 //! independent program draws in other places.
 
 use super::super::diagnosis::Residual;
-use image::RgbImage;
+use crate::rgb_image::RgbImage;
 
 /// Pixel by pixel. Both pictures have the same size (the caller checks).
 pub fn residual(expected: &RgbImage, actual: &RgbImage, threshold: f64) -> Residual {
@@ -70,7 +70,7 @@ fn block_means(picture: &RgbImage, block: u32) -> Vec<[f64; 3]> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use image::Rgb;
+    use crate::rgb_image::Rgb;
 
     #[test]
     fn pixels_and_blocks() {

@@ -20,7 +20,7 @@
 //! signature keeps its failing pixels, so the mistake explains nothing of it.
 
 use super::super::diagnosis::Residual;
-use image::RgbImage;
+use crate::rgb_image::RgbImage;
 
 /// How far (in pixels, at least 2, a fortieth of the picture) a student's speckle may be from the
 /// fault render's to be the same acne.
@@ -143,7 +143,7 @@ fn dilate(mask: &[bool], w: u32, h: u32, reach: u32) -> Vec<bool> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use image::Rgb;
+    use crate::rgb_image::Rgb;
 
     /// A lit grey square on black, with every `period`-th pixel of it `shade` (acne) or all.
     fn picture(period: u32, shade: u8) -> RgbImage {
