@@ -5,13 +5,12 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+use goldray::autograde::grade_submission;
 use goldray::autograde::gradescope::{RESULTS, SUBMISSION, results, write_results};
-use goldray::autograde::{SubmissionOptions, grade_submission};
-use goldray::grade::{Diagnose, GradeOptions, load_rubric};
-use goldray::sandbox::Sandbox;
+use goldray::grade::load_rubric;
 
 use super::Failure;
-use super::common::{LimitFlags, ProgramFlags, ThreadFlags, own_binary};
+use super::common::SubmissionFlags;
 use super::progress::Reporter;
 
 #[derive(Clone, Debug, clap::Args)]
@@ -25,23 +24,12 @@ pub struct AutogradeArgs {
     /// Where Gradescope reads the results.
     #[arg(long, default_value = RESULTS)]
     results: PathBuf,
-    #[command(flatten)]
-    program: ProgramFlags,
     /// Folder for the HTML report (and the program's renders) [default: `report` beside
     /// --results].
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Golden image cache [default: the user cache folder's goldray/goldens; fill it when the
-    /// autograder image is built, so that grading renders nothing].
-    #[arg(long)]
-    cache: Option<PathBuf>,
-    /// Do not name the mistakes.
-    #[arg(long)]
-    no_diagnose: bool,
     #[command(flatten)]
-    threads: ThreadFlags,
-    #[command(flatten)]
-    limits: LimitFlags,
+    grading: SubmissionFlags,
 }
 
 pub fn run(args: AutogradeArgs) -> Result<ExitCode, Failure> {
@@ -50,23 +38,13 @@ pub fn run(args: AutogradeArgs) -> Result<ExitCode, Failure> {
         .out
         .clone()
         .unwrap_or_else(|| goldray::atomic_write::parent_folder(&args.results).join("report"));
-    let options = SubmissionOptions {
-        submission: args.submission.clone(),
-        name: "submission".to_owned(),
-        program: args.program.section(),
-        limits: args.limits.overrides(),
-        sandbox: Some(Sandbox::new(own_binary()?)),
-        grade: GradeOptions {
-            out,
-            cache: args.cache.clone(),
-            force: true,
-            ..GradeOptions::default()
-        },
-        diagnose: if args.no_diagnose { Diagnose::No } else { Diagnose::Yes },
-    };
+    let options = args
+        .grading
+        .options(args.submission.clone(), "submission".to_owned(), out)?;
     // The autograder's log is for the TA: a line per step.
     let reporter = Reporter::new(false);
     let graded = args
+        .grading
         .threads
         .install(|| grade_submission(&args.rubric, &options, &reporter))??;
     let results = results(&rubric.title, &graded.student, &rubric.gradescope, graded.run.as_ref());

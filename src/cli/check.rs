@@ -6,12 +6,11 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use goldray::autograde::{SubmissionOptions, grade_submission};
-use goldray::grade::{Diagnose, GradeOptions, student_feedback};
-use goldray::sandbox::Sandbox;
+use goldray::autograde::grade_submission;
+use goldray::grade::student_feedback;
 
 use super::Failure;
-use super::common::{LimitFlags, ProgramFlags, ThreadFlags, own_binary};
+use super::common::SubmissionFlags;
 use super::progress::Reporter;
 
 #[derive(Clone, Debug, clap::Args)]
@@ -22,22 +21,12 @@ pub struct CheckArgs {
     /// The folder to check: your renders (a01.png …), or your sources with --program.
     #[arg(value_name = "DIR")]
     folder: PathBuf,
-    #[command(flatten)]
-    program: ProgramFlags,
     /// Keep the HTML report (and, with a program, its renders) in this folder [default: a
     /// temporary folder, removed afterwards].
     #[arg(long)]
     out: Option<PathBuf>,
-    /// Golden image cache [default: the user cache folder's goldray/goldens].
-    #[arg(long)]
-    cache: Option<PathBuf>,
-    /// Do not name the mistakes (faster: no fault renders).
-    #[arg(long)]
-    no_diagnose: bool,
     #[command(flatten)]
-    threads: ThreadFlags,
-    #[command(flatten)]
-    limits: LimitFlags,
+    grading: SubmissionFlags,
     /// Only the exit code.
     #[arg(long)]
     quiet: bool,
@@ -53,26 +42,15 @@ pub fn run(args: CheckArgs) -> Result<ExitCode, Failure> {
         .clone()
         .or_else(|| temporary.as_ref().map(|t| t.path().to_path_buf()))
         .unwrap_or_default();
-    let options = SubmissionOptions {
-        submission: args.folder.clone(),
-        name: args
-            .folder
-            .file_name()
-            .map_or_else(|| "submission".to_owned(), |n| n.to_string_lossy().into_owned()),
-        program: args.program.section(),
-        limits: args.limits.overrides(),
-        sandbox: Some(Sandbox::new(own_binary()?)),
-        grade: GradeOptions {
-            out: out.clone(),
-            cache: args.cache.clone(),
-            force: true,
-            ..GradeOptions::default()
-        },
-        diagnose: if args.no_diagnose { Diagnose::No } else { Diagnose::Yes },
-    };
+    let name = args
+        .folder
+        .file_name()
+        .map_or_else(|| "submission".to_owned(), |n| n.to_string_lossy().into_owned());
+    let options = args.grading.options(args.folder.clone(), name, out.clone())?;
     // Progress goes to stderr; stdout holds only what the student reads.
     let reporter = Reporter::new(args.quiet);
     let graded = args
+        .grading
         .threads
         .install(|| grade_submission(&args.rubric, &options, &reporter))??;
     if !args.quiet {

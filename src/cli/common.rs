@@ -4,9 +4,10 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use goldray::grade::ProgramSection;
+use goldray::autograde::SubmissionOptions;
+use goldray::grade::{Diagnose, GradeOptions, ProgramSection};
 use goldray::image_size::{SizeLimit, check_side};
-use goldray::sandbox::{LimitOverrides, parse_bytes, parse_duration};
+use goldray::sandbox::{LimitOverrides, Sandbox, parse_bytes, parse_duration};
 
 /// `--threads N`, the same on every command that works in parallel.
 #[derive(Clone, Debug, clap::Args)]
@@ -63,25 +64,51 @@ impl LimitFlags {
     }
 }
 
-/// `--program` and `--build` for grading one submission from its program (`check`,
-/// `autograde`): when given, they replace the rubric's `[program]`.
+/// How `check` and `autograde` grade one submission: from its program or its pictures, with which
+/// cache, threads and limits, and whether mistakes are named.
 #[derive(Clone, Debug, clap::Args)]
-pub struct ProgramFlags {
+pub struct SubmissionFlags {
     /// Build and run the student's program first, as `goldray run` does, and grade its outputs:
     /// a path inside the submission or a command with arguments [default: the rubric's
     /// [program] command, if any; else the folder's pictures are graded].
     #[arg(long, num_args = 1.., value_name = "PROGRAM [ARGS]")]
-    pub program: Option<Vec<String>>,
+    program: Option<Vec<String>>,
     /// The build command for --program, run with `sh -c` in a copy of the submission.
     #[arg(long, value_name = "CMD", requires = "program")]
-    pub build: Option<String>,
+    build: Option<String>,
+    /// Golden image cache [default: the user cache folder's goldray/goldens; an autograder fills
+    /// it when its image is built, so that grading renders nothing].
+    #[arg(long)]
+    cache: Option<PathBuf>,
+    /// Do not name the mistakes (faster: no fault renders).
+    #[arg(long)]
+    no_diagnose: bool,
+    #[command(flatten)]
+    pub threads: ThreadFlags,
+    #[command(flatten)]
+    limits: LimitFlags,
 }
 
-impl ProgramFlags {
-    pub fn section(&self) -> Option<ProgramSection> {
-        self.program.clone().map(|command| ProgramSection {
-            command,
-            build: self.build.clone(),
+impl SubmissionFlags {
+    /// The options for grading `submission` as student `name`, its report in `out`; `--program`
+    /// and `--build`, when given, replace the rubric's `[program]`.
+    pub fn options(&self, submission: PathBuf, name: String, out: PathBuf) -> Result<SubmissionOptions, String> {
+        Ok(SubmissionOptions {
+            submission,
+            name,
+            program: self.program.clone().map(|command| ProgramSection {
+                command,
+                build: self.build.clone(),
+            }),
+            limits: self.limits.overrides(),
+            sandbox: Some(Sandbox::new(own_binary()?)),
+            grade: GradeOptions {
+                out,
+                cache: self.cache.clone(),
+                force: true,
+                ..GradeOptions::default()
+            },
+            diagnose: if self.no_diagnose { Diagnose::No } else { Diagnose::Yes },
         })
     }
 }
