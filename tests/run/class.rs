@@ -37,21 +37,17 @@ fn student(class: &Path, name: &str, extra: &[(&str, String)]) {
     }
 }
 
+/// `goldray run --programs CLASS` with the class's build and program, its renders into `out`.
+fn class_run(rubric: &Path, class: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
+    let (rubric, class, out) = (rubric.to_str().unwrap(), class.to_str().unwrap(), out.to_str().unwrap());
+    let mut args = vec!["run", "--rubric", rubric, "--programs", class, "--build", BUILD];
+    args.extend(["--program", "raytracer", "--out", out]);
+    args.extend(extra);
+    goldray(&args)
+}
+
 fn run_class(rubric: &Path, class: &Path, out: &Path) -> String {
-    let output = goldray(&[
-        "run",
-        "--rubric",
-        rubric.to_str().unwrap(),
-        "--programs",
-        class.to_str().unwrap(),
-        "--build",
-        BUILD,
-        "--program",
-        "raytracer",
-        "--out",
-        out.to_str().unwrap(),
-        "--quiet",
-    ]);
+    let output = class_run(rubric, class, out, &["--quiet"]);
     assert!(
         output.status.success(),
         "goldray run --programs failed:\n{}",
@@ -117,19 +113,7 @@ fn a_class_is_built_run_and_graded_with_every_failure_named_and_reruns_only_what
     fs::write(class.join("notes.txt"), "not a student").unwrap();
     let renders = dir.join("renders");
 
-    let output = goldray(&[
-        "run",
-        "--rubric",
-        rubric.to_str().unwrap(),
-        "--programs",
-        class.to_str().unwrap(),
-        "--build",
-        BUILD,
-        "--program",
-        "raytracer",
-        "--out",
-        renders.to_str().unwrap(),
-    ]);
+    let output = class_run(&rubric, &class, &renders, &[]);
     let summary = String::from_utf8_lossy(&output.stdout).into_owned();
     assert!(
         output.status.success(),
@@ -253,19 +237,7 @@ fn a_class_is_built_run_and_graded_with_every_failure_named_and_reruns_only_what
     assert!(images(&grades, "alice").iter().all(|i| i.get("program").is_none()));
 
     // Again: nothing changed, nothing runs (dave's endless loop would take its 10 s again).
-    let again = goldray(&[
-        "run",
-        "--rubric",
-        rubric.to_str().unwrap(),
-        "--programs",
-        class.to_str().unwrap(),
-        "--build",
-        BUILD,
-        "--program",
-        "raytracer",
-        "--out",
-        renders.to_str().unwrap(),
-    ]);
+    let again = class_run(&rubric, &class, &renders, &[]);
     let summary = String::from_utf8_lossy(&again.stdout);
     assert!(
         summary.contains("4 students: 0 run, 4 unchanged, 0 failed"),
