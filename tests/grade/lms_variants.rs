@@ -1,0 +1,95 @@
+//! The variations a platform's download comes in, each graded as the plain download is: a zip64
+//! class archive (its duplicate names refused as in any other).
+
+use std::fs;
+use std::io::{Cursor, Write};
+
+use goldray::grade::{Layout, Outcome};
+use zip::ZipWriter;
+use zip::write::SimpleFileOptions;
+
+use crate::lms::{canvas_name, grade, rename, setup};
+
+/// The end-of-central-directory record's signature, and the zip64 locator's.
+const EOCD: &[u8] = b"PK\x05\x06";
+const ZIP64_LOCATOR: &[u8] = b"PK\x06\x07";
+
+/// A zip64 archive of `entries`: the zip crate writes the zip64 end record when told of an
+/// extensible data sector (an empty one here), and the classic record is then made to say what a
+/// zip64 writer of a large archive says, that its counts and offset are in the zip64 record.
+fn zip64_of(entries: &[(String, Vec<u8>)]) -> Vec<u8> {
+    let mut zip = ZipWriter::new(Cursor::new(Vec::new()));
+    zip.set_raw_zip64_extensible_data_sector(Box::new([]));
+    let options = SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Deflated)
+        .large_file(true);
+    for (name, bytes) in entries {
+        zip.start_file(name, options).unwrap();
+        zip.write_all(bytes).unwrap();
+    }
+    let mut bytes = zip.finish().unwrap().into_inner();
+    let end = bytes.windows(4).rposition(|w| w == EOCD).unwrap();
+    assert!(
+        bytes[..end].windows(4).any(|w| w == ZIP64_LOCATOR),
+        "no zip64 end record"
+    );
+    bytes[end + 8..end + 12].copy_from_slice(&[0xff; 4]);
+    bytes[end + 16..end + 20].copy_from_slice(&[0xff; 4]);
+    bytes
+}
+
+#[test]
+fn a_zip64_archive_with_a_name_twice_refuses_both_copies_and_grades_the_rest() {
+    let (dir, students) = setup("");
+    let dir = dir.path();
+    let mut entries: Vec<(String, Vec<u8>)> = students[..2]
+        .iter()
+        .flat_map(|s| s.files.iter().map(move |(f, b)| (canvas_name(s, f), b.clone())))
+        .collect();
+    // Mallory's colour picture twice under one name (the second written as `colox` and renamed
+    // in the bytes: the zip crate's writer refuses a name twice), one copy good, one black.
+    let ada = &students[0].files;
+    entries.push(("mallorymal_105_9105_color.png".to_owned(), ada[0].1.clone()));
+    entries.push((
+        "mallorymal_105_9105_colox.png".to_owned(),
+        crate::lms::png(&image::RgbImage::new(100, 100)),
+    ));
+    entries.push(("mallorymal_105_9105_normals.png".to_owned(), ada[1].1.clone()));
+    let mut bytes = zip64_of(&entries);
+    rename(
+        &mut bytes,
+        b"mallorymal_105_9105_colox.png",
+        b"mallorymal_105_9105_color.png",
+    );
+    fs::write(dir.join("class.zip"), &bytes).unwrap();
+
+    let report = grade(dir, &dir.join("class.zip"), "report");
+    assert_eq!(report.layout, Layout::Canvas);
+    assert_eq!(report.students.len(), 3);
+    let verdicts = |name: &str| {
+        let student = report.students.iter().find(|s| s.name == name).unwrap();
+        student.images.iter().map(|i| i.outcome.word()).collect::<Vec<_>>()
+    };
+    assert_eq!(verdicts("lovelaceada"), ["pass", "pass", "pass"]);
+    assert_eq!(verdicts("kernighanbrian"), ["fail", "pass", "pass"]);
+    let mallory = report.students.iter().find(|s| s.name == "mallorymal").unwrap();
+    assert!(
+        matches!(&mallory.images[0].outcome, Outcome::Unreadable { reason } if reason.contains("several files of this name")),
+        "{:?}",
+        mallory.images[0]
+    );
+    assert_eq!(
+        (mallory.images[1].outcome.word(), mallory.images[2].outcome.word()),
+        ("pass", "missing")
+    );
+    let notes: Vec<&String> = mallory
+        .refused
+        .iter()
+        .filter(|n| n.contains("several files of this name"))
+        .collect();
+    assert_eq!(notes.len(), 1, "one note for the name: {:?}", mallory.refused);
+    assert!(
+        notes.iter().all(|n| n.starts_with("mallorymal_105_9105_color.png: ")),
+        "{notes:?}"
+    );
+}
