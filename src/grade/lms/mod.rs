@@ -10,10 +10,10 @@
 
 mod archive;
 pub mod canvas;
+mod found;
 pub mod moodle;
 mod stage;
 
-use std::collections::BTreeMap;
 use std::fs;
 use std::io;
 use std::path::{Path, PathBuf};
@@ -22,6 +22,8 @@ use serde::{Deserialize, Serialize};
 
 pub use archive::{Limits, Refusal};
 pub use stage::{Staged, stage};
+
+use found::{Found, placement};
 
 /// How the submissions were laid out.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
@@ -186,12 +188,6 @@ fn detect(top: &[(String, bool)]) -> Layout {
     }
 }
 
-/// A Canvas student's files have no folder: the report shows the pattern they share.
-fn canvas_folder(root: &Path, file: &canvas::CanvasFile) -> PathBuf {
-    let late = if file.late { "LATE_" } else { "" };
-    root.join(format!("{}_{late}{}_*", file.name, file.user_id))
-}
-
 /// The files under `dir`, relative to it, at most three levels down, links included as files
 /// (staging refuses them).
 fn walk(root: &Path, relative: &Path, depth: usize, files: &mut Vec<PathBuf>) {
@@ -261,147 +257,4 @@ fn read_archive(path: &Path, limits: Limits) -> io::Result<Class> {
         }
     }
     Ok(found.class(layout, Some(path.to_path_buf()), refused))
-}
-
-/// Whose file an archive entry is, under what name.
-struct Placement<'a> {
-    name: &'a str,
-    platform: Layout,
-    id: &'a str,
-    late: bool,
-    /// Where the student's files are, for the report.
-    folder: PathBuf,
-    /// The file's name in the student's folder.
-    relative: &'a str,
-}
-
-/// The student an entry named `name` of the archive at `archive` belongs to in `layout`.
-fn placement<'a>(layout: Layout, name: &'a str, archive: &Path) -> Option<Placement<'a>> {
-    let (first, rest) = match name.split_once('/') {
-        Some((first, rest)) => (first, Some(rest)),
-        None => (name, None),
-    };
-    if skipped(first) {
-        return None;
-    }
-    match (layout, rest) {
-        (Layout::Folders, Some(rest)) => Some(Placement {
-            name: first,
-            platform: Layout::Folders,
-            id: "",
-            late: false,
-            folder: archive.join(first),
-            relative: rest,
-        }),
-        (Layout::Moodle, _) => {
-            let m = moodle::parse(first)?;
-            let relative = rest.unwrap_or(m.rest);
-            let folder = &first[..first.len() - m.rest.len()];
-            (!relative.is_empty()).then(|| Placement {
-                name: m.full_name,
-                platform: Layout::Moodle,
-                id: m.participant,
-                late: false,
-                folder: archive.join(folder),
-                relative,
-            })
-        }
-        (Layout::Canvas, None) => {
-            let c = canvas::parse(first)?;
-            Some(Placement {
-                name: c.name,
-                platform: Layout::Canvas,
-                id: c.user_id,
-                late: c.late,
-                folder: canvas_folder(archive, &c),
-                relative: c.original,
-            })
-        }
-        _ => None,
-    }
-}
-
-/// Students as they are found, grouped by their id on the platform (a folder's name for plain
-/// folders).
-#[derive(Default)]
-struct Found {
-    students: BTreeMap<(Layout, String), Student>,
-    ignored: Vec<String>,
-}
-
-impl Found {
-    fn folder(&mut self, name: &str, path: &Path) {
-        let student = Student {
-            name: name.to_owned(),
-            lms: None,
-            source: Source::Folder(path.to_path_buf()),
-            shown: path.to_path_buf(),
-            refused: Vec::new(),
-        };
-        self.students.insert((Layout::Folders, name.to_owned()), student);
-    }
-
-    /// The student `place` names, made on first sight.
-    fn student(&mut self, place: &Placement) -> &mut Student {
-        let key = match place.platform {
-            Layout::Folders => place.name,
-            _ => place.id,
-        };
-        let student = self
-            .students
-            .entry((place.platform, key.to_owned()))
-            .or_insert_with(|| Student {
-                name: place.name.to_owned(),
-                lms: (place.platform != Layout::Folders).then(|| LmsId {
-                    platform: place.platform,
-                    id: place.id.to_owned(),
-                    late: false,
-                }),
-                source: Source::Files(Vec::new()),
-                shown: place.folder.clone(),
-                refused: Vec::new(),
-            });
-        if let Some(lms) = &mut student.lms {
-            lms.late |= place.late;
-        }
-        student
-    }
-
-    fn add(&mut self, place: &Placement, item: Item) {
-        if let Source::Files(items) = &mut self.student(place).source {
-            items.push(item);
-        }
-    }
-
-    fn refuse(&mut self, place: &Placement, refusal: Refusal) {
-        let relative = PathBuf::from(place.relative);
-        self.student(place).refused.push((relative, refusal));
-    }
-
-    /// The class, students sorted by name then id, names made distinct by their id.
-    fn class(self, layout: Layout, archive: Option<PathBuf>, refused: Vec<Refusal>) -> Class {
-        let mut students: Vec<Student> = self.students.into_values().collect();
-        let id = |s: &Student| s.lms.as_ref().map(|l| l.id.clone()).unwrap_or_default();
-        students.sort_by(|a, b| a.name.cmp(&b.name).then_with(|| id(a).cmp(&id(b))));
-        let mut counts: BTreeMap<String, usize> = BTreeMap::new();
-        for student in &students {
-            *counts.entry(student.name.clone()).or_default() += 1;
-        }
-        for student in &mut students {
-            if counts[&student.name] > 1
-                && let Some(lms) = &student.lms
-            {
-                student.name = format!("{} ({})", student.name, lms.id);
-            }
-        }
-        let mut ignored = self.ignored;
-        ignored.sort();
-        Class {
-            layout,
-            archive,
-            students,
-            ignored,
-            refused,
-        }
-    }
 }
