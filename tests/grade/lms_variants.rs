@@ -1,14 +1,16 @@
-//! The variations a platform's download comes in, each graded as the plain download is: a zip64
-//! class archive (its duplicate names refused as in any other).
+//! The variations a platform's download comes in, each graded as the plain download is: Moodle's
+//! folder of a participant who handed in nothing, and a zip64 class archive (its duplicate names
+//! refused as in any other).
 
 use std::fs;
 use std::io::{Cursor, Write};
 
-use goldray::grade::{Layout, Outcome};
+use goldray::grade::{ClassReport, Layout, Outcome};
 use zip::ZipWriter;
 use zip::write::SimpleFileOptions;
 
-use crate::lms::{canvas_name, grade, rename, setup};
+use crate::lms::{canvas_name, grade, moodle_zip, rename, setup};
+use crate::parse_csv;
 
 /// The end-of-central-directory record's signature, and the zip64 locator's.
 const EOCD: &[u8] = b"PK\x05\x06";
@@ -92,4 +94,80 @@ fn a_zip64_archive_with_a_name_twice_refuses_both_copies_and_grades_the_rest() {
         notes.iter().all(|n| n.starts_with("mallorymal_105_9105_color.png: ")),
         "{notes:?}"
     );
+}
+
+/// Moodle's download of the class, with two more participants who handed in no file: one with an
+/// empty `_file_` folder, one with only an online text.
+fn moodle_with_empty_folders(students: &[crate::lms::Student]) -> Vec<u8> {
+    let mut archive = zip::ZipArchive::new(Cursor::new(moodle_zip(students))).unwrap();
+    let mut zip = ZipWriter::new(Cursor::new(Vec::new()));
+    for index in 0..archive.len() {
+        zip.raw_copy_file(archive.by_index(index).unwrap()).unwrap();
+    }
+    let options = SimpleFileOptions::default();
+    zip.add_directory("Edsger Dijkstra_105_assignsubmission_file_/", options)
+        .unwrap();
+    zip.add_directory("Barbara Liskov_106_assignsubmission_onlinetext_/", options)
+        .unwrap();
+    zip.start_file(
+        "Barbara Liskov_106_assignsubmission_onlinetext_/onlinetext.html",
+        options,
+    )
+    .unwrap();
+    zip.write_all(b"<p>I ran out of time</p>").unwrap();
+    zip.finish().unwrap().into_inner()
+}
+
+#[test]
+fn a_moodle_participant_who_handed_in_no_file_is_graded_with_every_file_missing() {
+    let (dir, students) = setup("");
+    let dir = dir.path();
+    let bytes = moodle_with_empty_folders(&students);
+    fs::write(dir.join("moodle.zip"), &bytes).unwrap();
+    let extracted = dir.join("extracted");
+    zip::ZipArchive::new(Cursor::new(&bytes))
+        .unwrap()
+        .extract(&extracted)
+        .unwrap();
+    assert!(
+        fs::read_dir(extracted.join("Edsger Dijkstra_105_assignsubmission_file_"))
+            .unwrap()
+            .next()
+            .is_none(),
+        "the extracted folder is empty"
+    );
+
+    for (report, out) in [
+        (grade(dir, &dir.join("moodle.zip"), "zipped"), "zipped"),
+        (grade(dir, &extracted, "unzipped"), "unzipped"),
+    ] {
+        assert_eq!(report.layout, Layout::Moodle);
+        assert_eq!(report.students.len(), students.len() + 2, "{out}");
+        assert!(report.ignored.is_empty(), "{out}: {:?}", report.ignored);
+        for (name, id) in [("Edsger Dijkstra", "105"), ("Barbara Liskov", "106")] {
+            nobody_handed_in(&report, name, id);
+        }
+        let csv = parse_csv(&fs::read_to_string(dir.join(out).join("grades-moodle.csv")).unwrap());
+        for (name, id) in [("Edsger Dijkstra", "105"), ("Barbara Liskov", "106")] {
+            let row = csv.iter().find(|r| r[0] == format!("Participant {id}")).unwrap();
+            assert_eq!((row[1].as_str(), row[4].as_str()), (name, "0"), "{out}: {row:?}");
+        }
+    }
+}
+
+/// `name` is a student of `report` with participant id `id`, every file missing and no points.
+fn nobody_handed_in(report: &ClassReport, name: &str, id: &str) {
+    let student = report
+        .students
+        .iter()
+        .find(|s| s.name == name)
+        .unwrap_or_else(|| panic!("{name} is not graded"));
+    let lms = student.lms.as_ref().unwrap();
+    assert_eq!((lms.platform, lms.id.as_str()), (Layout::Moodle, id));
+    assert!(
+        student.images.iter().all(|i| i.outcome == Outcome::Missing),
+        "{name}: {:?}",
+        student.images
+    );
+    assert_eq!(student.total, 0.0);
 }

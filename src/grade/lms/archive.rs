@@ -93,6 +93,8 @@ pub struct Archive<R> {
     zip: ZipArchive<R>,
     pub entries: Vec<Entry>,
     pub refused: Vec<Refusal>,
+    /// The names of the folders the archive lists (`a/b/`), which hold nothing to extract.
+    pub folders: Vec<String>,
     limits: Limits,
 }
 
@@ -119,7 +121,7 @@ impl<R: Read + Seek> Archive<R> {
             zip = ZipArchive::new(reader).map_err(|e| unreadable_archive(&e))?;
         }
         let count = zip.len().max(duplicates.values().sum());
-        let (mut entries, mut refused) = (Vec::new(), Vec::new());
+        let (mut entries, mut refused, mut folders) = (Vec::new(), Vec::new(), Vec::new());
         if count > limits.entries {
             return Err(format!(
                 "the archive holds {} entries, over the limit of {} (a zip bomb?): not read",
@@ -144,6 +146,11 @@ impl<R: Read + Seek> Archive<R> {
                     reason: "a symbolic link in the archive: not read".to_owned(),
                 })
             } else if file.is_dir() {
+                // Nothing is written for a folder, but it may be a student who handed in nothing
+                // (Moodle's folder of a participant without files).
+                if !leaves_folder(&name) {
+                    folders.push(name);
+                }
                 continue;
             } else if leaves_folder(&name) || file.enclosed_name().is_none() {
                 Some(unreadable(
@@ -196,6 +203,7 @@ impl<R: Read + Seek> Archive<R> {
             zip,
             entries,
             refused,
+            folders,
             limits,
         })
     }

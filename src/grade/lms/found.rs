@@ -18,13 +18,15 @@ pub(super) struct Placement<'a> {
     pub(super) relative: &'a str,
 }
 
-/// The student an entry named `name` of the archive at `archive` belongs to in `layout`.
+/// The student an entry named `name` of the archive at `archive` belongs to in `layout`. A folder
+/// is named with its `/` (`Full Name_ID_assignsubmission_file_/`): its placement is the student
+/// with an empty `relative`.
 pub(super) fn placement<'a>(layout: Layout, name: &'a str, archive: &Path) -> Option<Placement<'a>> {
     let (first, rest) = match name.split_once('/') {
         Some((first, rest)) => (first, Some(rest)),
         None => (name, None),
     };
-    if skipped(first) {
+    if skipped(first) || first.is_empty() {
         return None;
     }
     match (layout, rest) {
@@ -40,7 +42,7 @@ pub(super) fn placement<'a>(layout: Layout, name: &'a str, archive: &Path) -> Op
             let m = moodle::parse(first)?;
             let relative = rest.unwrap_or(m.rest);
             let folder = &first[..first.len() - m.rest.len()];
-            (!relative.is_empty()).then(|| Placement {
+            (rest.is_some() || !relative.is_empty()).then(|| Placement {
                 name: m.full_name,
                 platform: Layout::Moodle,
                 id: m.participant,
@@ -108,6 +110,12 @@ impl Found {
             lms.late |= place.late;
         }
         student
+    }
+
+    /// The student `place` names, with or without files: a Moodle participant's empty folder is
+    /// a student who handed in nothing, graded with every file missing, not a folder to ignore.
+    pub(super) fn enrol(&mut self, place: &Placement) {
+        self.student(place);
     }
 
     pub(super) fn add(&mut self, place: &Placement, item: Item) {

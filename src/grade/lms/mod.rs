@@ -144,13 +144,17 @@ pub fn read_class(submissions: &Path, own: &[&PathBuf], limits: Limits) -> io::R
             found.folder(&name, &path);
             continue;
         }
+        let mut placed = false;
+        if is_dir && let Some(place) = placement(layout, &format!("{name}/"), submissions) {
+            found.enrol(&place);
+            placed = true;
+        }
         let mut files = Vec::new();
         if is_dir {
             walk(&path, Path::new(""), 0, &mut files);
         } else {
             files.push(PathBuf::new());
         }
-        let mut placed = false;
         for relative in files {
             let within = Path::new(&name).join(&relative);
             let within = within.to_string_lossy();
@@ -222,8 +226,10 @@ fn read_archive(path: &Path, limits: Limits) -> io::Result<Class> {
     let mut top: Vec<(String, bool)> = archive
         .entries
         .iter()
-        .map(|e| {
-            let mut parts = e.name.splitn(2, '/');
+        .map(|e| &e.name)
+        .chain(&archive.folders)
+        .map(|name| {
+            let mut parts = name.splitn(2, '/');
             let first = parts.next().unwrap_or_default().to_owned();
             (first, parts.next().is_some())
         })
@@ -247,6 +253,12 @@ fn read_archive(path: &Path, limits: Limits) -> io::Result<Class> {
                 found.ignored.push(entry.name.clone())
             }
             None => {}
+        }
+    }
+    for folder in &archive.folders {
+        let name = format!("{}/", folder.split('/').next().unwrap_or_default());
+        if let Some(place) = placement(layout, &name, path) {
+            found.enrol(&place);
         }
     }
     let mut refused = Vec::new();
