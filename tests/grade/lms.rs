@@ -201,22 +201,29 @@ fn canvas_and_moodle_downloads_grade_like_folders_with_the_platforms_names_and_i
         .unwrap()
         .extract(&extracted)
         .unwrap();
+    let canvas_extracted = dir.join("canvas-extracted");
+    zip::ZipArchive::new(Cursor::new(canvas_zip(&students)))
+        .unwrap()
+        .extract(&canvas_extracted)
+        .unwrap();
 
     let plain = grade(dir, &dir.join("folders"), "plain");
     let canvas = grade(dir, &dir.join("canvas.zip"), "canvas");
     let moodle = grade(dir, &dir.join("moodle.zip"), "moodle");
     let unzipped = grade(dir, &extracted, "unzipped");
+    let canvas_unzipped = grade(dir, &canvas_extracted, "canvas-unzipped");
     assert_eq!(plain.layout, Layout::Folders);
     assert_eq!(canvas.layout, Layout::Canvas);
     assert_eq!(moodle.layout, Layout::Moodle);
     assert_eq!(unzipped.layout, Layout::Moodle);
+    assert_eq!(canvas_unzipped.layout, Layout::Canvas);
     let expected = scores(&plain, &students);
     assert_eq!(expected.len(), 4);
     // The late student lost points on colour, the wrong name costs colour, the own zip is read.
     assert_eq!(expected[1].1[0], ("fail", 0.0));
     assert_eq!(expected[2].1, [("fail", 0.0), ("pass", 1.0), ("pass", 1.0)]);
     assert_eq!(expected[3].1[0], ("missing", 0.0));
-    for report in [&canvas, &moodle, &unzipped] {
+    for report in [&canvas, &moodle, &unzipped, &canvas_unzipped] {
         assert_eq!(scores(report, &students), expected, "{:?}", report.layout);
     }
 

@@ -149,20 +149,24 @@ pub fn read_class(submissions: &Path, own: &[&PathBuf], limits: Limits) -> io::R
             found.enrol(&place);
             placed = true;
         }
-        let mut files = Vec::new();
-        if is_dir {
-            walk(&path, Path::new(""), 0, &mut files);
+        // Each file as the download names it (`folder/file` or `file`), and where it is. A top
+        // file is `path` itself: `path.join("")` would be `path/`, which no file can be opened as.
+        let files: Vec<(PathBuf, PathBuf)> = if is_dir {
+            let mut relative = Vec::new();
+            walk(&path, Path::new(""), 0, &mut relative);
+            relative
+                .iter()
+                .map(|r| (Path::new(&name).join(r), path.join(r)))
+                .collect()
         } else {
-            files.push(PathBuf::new());
-        }
-        for relative in files {
-            let within = Path::new(&name).join(&relative);
-            let within = within.to_string_lossy();
-            if let Some(place) = placement(layout, within.trim_end_matches('/'), submissions) {
+            vec![(PathBuf::from(&name), path.clone())]
+        };
+        for (within, file) in files {
+            if let Some(place) = placement(layout, &within.to_string_lossy(), submissions) {
                 let item = Item {
                     path: PathBuf::from(place.relative),
-                    origin: Origin::File(path.join(&relative)),
-                    shown: path.join(&relative).display().to_string(),
+                    shown: file.display().to_string(),
+                    origin: Origin::File(file),
                 };
                 found.add(&place, item);
                 placed = true;
