@@ -1,6 +1,6 @@
 //! The variations a platform's download comes in, each graded as the plain download is: Moodle's
-//! folder of a participant who handed in nothing, and a zip64 class archive (its duplicate names
-//! refused as in any other).
+//! prefixed files instead of folders, Moodle's folder of a participant who handed in nothing, and a
+//! zip64 class archive (its duplicate names refused as in any other).
 
 use std::fs;
 use std::io::{Cursor, Write};
@@ -9,7 +9,7 @@ use goldray::grade::{ClassReport, Layout, Outcome};
 use zip::ZipWriter;
 use zip::write::SimpleFileOptions;
 
-use crate::lms::{canvas_name, grade, moodle_zip, rename, setup};
+use crate::lms::{canvas_name, folders, grade, moodle_folder, moodle_zip, rename, scores, setup, zip_of};
 use crate::parse_csv;
 
 /// The end-of-central-directory record's signature, and the zip64 locator's.
@@ -94,6 +94,62 @@ fn a_zip64_archive_with_a_name_twice_refuses_both_copies_and_grades_the_rest() {
         notes.iter().all(|n| n.starts_with("mallorymal_105_9105_color.png: ")),
         "{notes:?}"
     );
+}
+
+/// Moodle's download with "Download submissions in folders" unticked: every file at the top, its
+/// name prefixed with what would have been its folder's.
+fn moodle_flat_zip(students: &[crate::lms::Student]) -> Vec<u8> {
+    let mut entries: Vec<(String, Vec<u8>)> = students
+        .iter()
+        .flat_map(|s| {
+            s.files
+                .iter()
+                .map(move |(f, b)| (format!("{}{f}", moodle_folder(s)), b.clone()))
+        })
+        .collect();
+    entries.push((
+        "Ada Lovelace_101_assignsubmission_onlinetext_onlinetext.html".to_owned(),
+        b"<p>see my renders</p>".to_vec(),
+    ));
+    zip_of(&entries)
+}
+
+#[test]
+fn moodle_prefixed_files_grade_like_its_folders_with_names_and_ids() {
+    let (dir, students) = setup("");
+    let dir = dir.path();
+    folders(&students, &dir.join("folders"));
+    let bytes = moodle_flat_zip(&students);
+    fs::write(dir.join("flat.zip"), &bytes).unwrap();
+    let extracted = dir.join("flat");
+    zip::ZipArchive::new(Cursor::new(&bytes))
+        .unwrap()
+        .extract(&extracted)
+        .unwrap();
+
+    let plain = grade(dir, &dir.join("folders"), "plain");
+    let expected = scores(&plain, &students);
+    for (submissions, out) in [(dir.join("flat.zip"), "zipped"), (extracted.clone(), "unzipped")] {
+        let report = grade(dir, &submissions, out);
+        assert_eq!(report.layout, Layout::Moodle, "{out}");
+        assert_eq!(scores(&report, &students), expected, "{out}");
+        assert!(report.ignored.is_empty(), "{out}: {:?}", report.ignored);
+        for student in &students {
+            let graded = report.students.iter().find(|s| s.name == student.full_name).unwrap();
+            let lms = graded.lms.as_ref().unwrap();
+            assert_eq!((lms.platform, lms.id.as_str()), (Layout::Moodle, student.id));
+        }
+        let ada = report.students.iter().find(|s| s.name == "Ada Lovelace").unwrap();
+        assert_eq!(ada.folder, submissions.join("Ada Lovelace_101_assignsubmission_*"));
+        assert_eq!(
+            ada.images[1].graded_file.as_deref(),
+            Some(
+                submissions
+                    .join("Ada Lovelace_101_assignsubmission_file_normals.png")
+                    .as_path()
+            )
+        );
+    }
 }
 
 /// Moodle's download of the class, with two more participants who handed in no file: one with an

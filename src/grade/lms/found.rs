@@ -41,13 +41,18 @@ pub(super) fn placement<'a>(layout: Layout, name: &'a str, archive: &Path) -> Op
         (Layout::Moodle, _) => {
             let m = moodle::parse(first)?;
             let relative = rest.unwrap_or(m.rest);
-            let folder = &first[..first.len() - m.rest.len()];
-            (rest.is_some() || !relative.is_empty()).then(|| Placement {
+            // Prefixed files ("Download submissions in folders" unticked) have no folder: the
+            // report shows the prefix they share.
+            let folder = match rest {
+                Some(_) => archive.join(first),
+                None => archive.join(format!("{}_{}_assignsubmission_*", m.full_name, m.participant)),
+            };
+            (rest.is_some() || !relative.is_empty()).then_some(Placement {
                 name: m.full_name,
                 platform: Layout::Moodle,
                 id: m.participant,
                 late: false,
-                folder: archive.join(folder),
+                folder,
                 relative,
             })
         }
