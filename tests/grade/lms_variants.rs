@@ -1,5 +1,5 @@
-//! The variations a platform's download comes in, each graded as the plain download is: Moodle's
-//! prefixed files instead of folders, Moodle's folder of a participant who handed in nothing, and a
+//! The variations a platform's download comes in, each graded as the plain download is: Canvas's
+//! renamed resubmissions, Moodle's prefixed files instead of folders, Moodle's folder of a participant who handed in nothing, and a
 //! zip64 class archive (its duplicate names refused as in any other).
 
 use std::fs;
@@ -9,7 +9,9 @@ use goldray::grade::{ClassReport, Layout, Outcome};
 use zip::ZipWriter;
 use zip::write::SimpleFileOptions;
 
-use crate::lms::{canvas_name, folders, grade, moodle_folder, moodle_zip, rename, scores, setup, zip_of};
+use crate::lms::{
+    Student, canvas_name, canvas_zip, folders, grade, moodle_folder, moodle_zip, rename, scores, setup, zip_of,
+};
 use crate::parse_csv;
 
 /// The end-of-central-directory record's signature, and the zip64 locator's.
@@ -96,9 +98,79 @@ fn a_zip64_archive_with_a_name_twice_refuses_both_copies_and_grades_the_rest() {
     );
 }
 
+/// A Canvas download's name for `student`'s upload `file` that Canvas gave the id `submission`.
+fn canvas_upload(student: &Student, submission: u32, file: &str) -> String {
+    let late = if student.late { "LATE_" } else { "" };
+    format!("{}_{late}{}_{submission}_{file}", student.canvas, student.id)
+}
+
+#[test]
+fn canvas_resubmissions_grade_under_the_names_first_uploaded() {
+    let (dir, students) = setup("");
+    let dir = dir.path();
+    let [ada, brian, grace, dennis] = &students[..] else {
+        unreachable!()
+    };
+    let mut entries = Vec::new();
+    // Ada uploaded everything again, her depth picture a third time.
+    for (file, again, submission) in [
+        ("color.png", "color-1.png", 9201),
+        ("normals.png", "normals-1.png", 9202),
+        ("depth.png", "depth-2.png", 9303),
+    ] {
+        let bytes = ada.files.iter().find(|(f, _)| f == file).unwrap().1.clone();
+        entries.push((canvas_upload(ada, submission, again), bytes));
+    }
+    // Brian first uploaded a good colour picture, then his broken one, which as the newest is the
+    // one graded.
+    entries.push((canvas_upload(brian, 9102, "color.png"), ada.files[0].1.clone()));
+    entries.push((canvas_upload(brian, 9402, "color-1.png"), brian.files[0].1.clone()));
+    for (file, bytes) in &brian.files[1..] {
+        entries.push((canvas_name(brian, file), bytes.clone()));
+    }
+    // Grace's own zip, uploaded again, is read under its name (no rubric file, but no other
+    // upload of that name); Dennis handed in once.
+    entries.push((canvas_upload(grace, 9503, "renders-1.zip"), grace.files[0].1.clone()));
+    for (file, bytes) in &dennis.files {
+        entries.push((canvas_name(dennis, file), bytes.clone()));
+    }
+    let bytes = zip_of(&entries);
+    fs::write(dir.join("canvas.zip"), canvas_zip(&students)).unwrap();
+    fs::write(dir.join("resubmitted.zip"), &bytes).unwrap();
+    let extracted = dir.join("resubmitted");
+    zip::ZipArchive::new(Cursor::new(&bytes))
+        .unwrap()
+        .extract(&extracted)
+        .unwrap();
+
+    let expected = scores(&grade(dir, &dir.join("canvas.zip"), "original"), &students);
+    assert_eq!(expected[1].1[0], ("fail", 0.0), "Brian's colour picture fails");
+    for (submissions, out) in [(dir.join("resubmitted.zip"), "zipped"), (extracted, "unzipped")] {
+        let report = grade(dir, &submissions, out);
+        assert_eq!(report.layout, Layout::Canvas, "{out}");
+        assert_eq!(scores(&report, &students), expected, "{out}");
+        let graded = |name: &str| report.students.iter().find(|s| s.name == name).unwrap();
+        assert_eq!(
+            graded("lovelaceada").images[2].graded_file.as_deref(),
+            Some(submissions.join("lovelaceada_101_9303_depth-2.png").as_path()),
+            "{out}"
+        );
+        let notes = &graded("kernighanbrian").refused;
+        assert_eq!(notes.len(), 1, "{out}: {notes:?}");
+        assert!(
+            notes[0].ends_with(
+                "kernighanbrian_LATE_102_9102_color.png: an earlier upload of color.png, superseded by \
+                 kernighanbrian_LATE_102_9402_color-1.png: not read"
+            ),
+            "{out}: {notes:?}"
+        );
+        assert!(graded("lovelaceada").refused.is_empty(), "{out}");
+    }
+}
+
 /// Moodle's download with "Download submissions in folders" unticked: every file at the top, its
 /// name prefixed with what would have been its folder's.
-fn moodle_flat_zip(students: &[crate::lms::Student]) -> Vec<u8> {
+fn moodle_flat_zip(students: &[Student]) -> Vec<u8> {
     let mut entries: Vec<(String, Vec<u8>)> = students
         .iter()
         .flat_map(|s| {
@@ -154,7 +226,7 @@ fn moodle_prefixed_files_grade_like_its_folders_with_names_and_ids() {
 
 /// Moodle's download of the class, with two more participants who handed in no file: one with an
 /// empty `_file_` folder, one with only an online text.
-fn moodle_with_empty_folders(students: &[crate::lms::Student]) -> Vec<u8> {
+fn moodle_with_empty_folders(students: &[Student]) -> Vec<u8> {
     let mut archive = zip::ZipArchive::new(Cursor::new(moodle_zip(students))).unwrap();
     let mut zip = ZipWriter::new(Cursor::new(Vec::new()));
     for index in 0..archive.len() {

@@ -4,6 +4,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
+use super::resubmission::{self, Kind, Upload};
 use super::{Class, Item, Layout, LmsId, Refusal, Source, Student, canvas, moodle, skipped};
 
 /// Whose file an archive entry is, under what name.
@@ -12,6 +13,8 @@ pub(super) struct Placement<'a> {
     platform: Layout,
     id: &'a str,
     late: bool,
+    /// Canvas's id of the file (empty elsewhere): which of two uploads is the newer.
+    submission: &'a str,
     /// Where the student's files are, for the report.
     folder: PathBuf,
     /// The file's name in the student's folder.
@@ -35,6 +38,7 @@ pub(super) fn placement<'a>(layout: Layout, name: &'a str, archive: &Path) -> Op
             platform: Layout::Folders,
             id: "",
             late: false,
+            submission: "",
             folder: archive.join(first),
             relative: rest,
         }),
@@ -52,6 +56,7 @@ pub(super) fn placement<'a>(layout: Layout, name: &'a str, archive: &Path) -> Op
                 platform: Layout::Moodle,
                 id: m.participant,
                 late: false,
+                submission: "",
                 folder,
                 relative,
             })
@@ -63,6 +68,7 @@ pub(super) fn placement<'a>(layout: Layout, name: &'a str, archive: &Path) -> Op
                 platform: Layout::Canvas,
                 id: c.user_id,
                 late: c.late,
+                submission: c.submission_id,
                 folder: canvas_folder(archive, &c),
                 relative: c.original,
             })
@@ -76,6 +82,9 @@ pub(super) fn placement<'a>(layout: Layout, name: &'a str, archive: &Path) -> Op
 #[derive(Default)]
 pub(super) struct Found {
     students: BTreeMap<(Layout, String), Student>,
+    /// Canvas students' files and refused entries by user id, held back until all are known:
+    /// whether `a01-1.png` is a resubmission to restore depends on the student's other uploads.
+    uploads: BTreeMap<String, Vec<Upload>>,
     pub(super) ignored: Vec<String>,
 }
 
@@ -124,18 +133,47 @@ impl Found {
     }
 
     pub(super) fn add(&mut self, place: &Placement, item: Item) {
-        if let Source::Files(items) = &mut self.student(place).source {
+        if place.platform == Layout::Canvas {
+            self.upload(place, Kind::File(item));
+        } else if let Source::Files(items) = &mut self.student(place).source {
             items.push(item);
         }
     }
 
     pub(super) fn refuse(&mut self, place: &Placement, refusal: Refusal) {
-        let relative = PathBuf::from(place.relative);
-        self.student(place).refused.push((relative, refusal));
+        if place.platform == Layout::Canvas {
+            self.upload(place, Kind::Refused(refusal));
+        } else {
+            let relative = PathBuf::from(place.relative);
+            self.student(place).refused.push((relative, refusal));
+        }
     }
 
-    /// The class, students sorted by name then id, names made distinct by their id.
-    pub(super) fn class(self, layout: Layout, archive: Option<PathBuf>, refused: Vec<Refusal>) -> Class {
+    fn upload(&mut self, place: &Placement, kind: Kind) {
+        self.student(place);
+        self.uploads.entry(place.id.to_owned()).or_default().push(Upload {
+            name: place.relative.to_owned(),
+            submission: place.submission.to_owned(),
+            kind,
+        });
+    }
+
+    /// The class, students sorted by name then id, names made distinct by their id; Canvas's
+    /// resubmissions resolved against the rubric's `expected` file names.
+    pub(super) fn class(
+        mut self,
+        layout: Layout,
+        archive: Option<PathBuf>,
+        refused: Vec<Refusal>,
+        expected: &[&str],
+    ) -> Class {
+        for (id, uploads) in std::mem::take(&mut self.uploads) {
+            let (items, refusals) = resubmission::resolve(uploads, expected);
+            if let Some(student) = self.students.get_mut(&(Layout::Canvas, id)) {
+                student.source = Source::Files(items);
+                student.refused.extend(refusals);
+            }
+        }
         let mut students: Vec<Student> = self.students.into_values().collect();
         let id = |s: &Student| s.lms.as_ref().map(|l| l.id.clone()).unwrap_or_default();
         students.sort_by(|a, b| a.name.cmp(&b.name).then_with(|| id(a).cmp(&id(b))));

@@ -3,7 +3,8 @@
 //!
 //! [`read_class`] finds the students and their files without extracting anything: a plain
 //! folder's students are its folders, as ever; a download's students are found by the names the
-//! platform gives (see `canvas` and `moodle`), each with their name and id on the platform. A
+//! platform gives (see `canvas` and `moodle`), each with their name and id on the platform, and
+//! the names Canvas changes when a file is uploaded again given back (see `resubmission`). A
 //! student whose files are not a folder of their own is [`stage`]d just before grading: their
 //! files copied (out of the archive, with its checks) into a folder of a temporary directory,
 //! their own zips expanded beside them, and the report told where each file came from.
@@ -12,6 +13,7 @@ mod archive;
 pub mod canvas;
 mod found;
 pub mod moodle;
+mod resubmission;
 mod stage;
 
 use std::fs;
@@ -95,7 +97,8 @@ pub struct Student {
     pub source: Source,
     /// Where the student's files are, for the report.
     pub shown: PathBuf,
-    /// Their archive entries that were refused, under the names they would have had.
+    /// Their archive entries that were refused, under the names they would have had, and their
+    /// Canvas uploads that a newer one of the same name superseded, under their download names.
     pub refused: Vec<(PathBuf, Refusal)>,
 }
 
@@ -118,10 +121,11 @@ pub fn is_archive(path: &Path) -> bool {
 }
 
 /// The class in `submissions` (a folder or a `.zip`), skipping hidden entries, `__MACOSX` and
-/// the folders of `own` (the report, the cache).
-pub fn read_class(submissions: &Path, own: &[&PathBuf], limits: Limits) -> io::Result<Class> {
+/// the folders of `own` (the report, the cache). `expected` are the file names the rubric
+/// expects, which decide whether Canvas's `a01-1.png` is given back its name `a01.png`.
+pub fn read_class(submissions: &Path, own: &[&PathBuf], expected: &[&str], limits: Limits) -> io::Result<Class> {
     if is_archive(submissions) {
-        return read_archive(submissions, limits);
+        return read_archive(submissions, expected, limits);
     }
     let own: Vec<PathBuf> = own.iter().filter_map(|p| p.canonicalize().ok()).collect();
     let mut entries: Vec<(String, PathBuf, bool)> = Vec::new();
@@ -176,7 +180,7 @@ pub fn read_class(submissions: &Path, own: &[&PathBuf], limits: Limits) -> io::R
             found.ignored.push(name);
         }
     }
-    Ok(found.class(layout, None, Vec::new()))
+    Ok(found.class(layout, None, Vec::new(), expected))
 }
 
 /// Hidden entries and macOS archive litter.
@@ -223,7 +227,7 @@ fn walk(root: &Path, relative: &Path, depth: usize, files: &mut Vec<PathBuf>) {
 }
 
 /// A class archive: its entries sorted into students by the layout their names follow.
-fn read_archive(path: &Path, limits: Limits) -> io::Result<Class> {
+fn read_archive(path: &Path, expected: &[&str], limits: Limits) -> io::Result<Class> {
     let archive = archive::Archive::open(path, limits)
         .map_err(|reason| io::Error::new(io::ErrorKind::InvalidData, format!("{}: {reason}", path.display())))?;
     let shown = |name: &str| format!("{}/{name}", path.display());
@@ -272,5 +276,5 @@ fn read_archive(path: &Path, limits: Limits) -> io::Result<Class> {
             None => refused.push(refusal.clone()),
         }
     }
-    Ok(found.class(layout, Some(path.to_path_buf()), refused))
+    Ok(found.class(layout, Some(path.to_path_buf()), refused, expected))
 }
