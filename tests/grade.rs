@@ -16,6 +16,8 @@ mod cli;
 mod integrity;
 #[path = "grade/lms.rs"]
 mod lms;
+#[path = "grade/lms_variants.rs"]
+mod lms_variants;
 #[path = "grade/memory.rs"]
 mod memory;
 #[path = "grade/platform.rs"]

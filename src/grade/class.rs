@@ -44,7 +44,8 @@ pub fn grade(
     let started = Instant::now();
     let rubric = load_rubric(rubric_path)?;
     let cache = options.cache.clone().unwrap_or_else(default_cache_dir);
-    let class = read_class(submissions, &[&options.out, &cache], Limits::default()).map_err(|source| {
+    let expected: Vec<&str> = rubric.images.iter().map(|spec| spec.file.as_str()).collect();
+    let class = read_class(submissions, &[&options.out, &cache], &expected, Limits::default()).map_err(|source| {
         GradeError::Submissions {
             path: submissions.to_path_buf(),
             source,

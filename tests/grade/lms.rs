@@ -17,20 +17,20 @@ use crate::class::{case, pictures, render, rubric_text, scene_path};
 use crate::{chromium, parse_csv};
 
 /// One student of the class: the name each platform gives them, their ids, and their files.
-struct Student {
-    full_name: &'static str,
-    canvas: &'static str,
-    id: &'static str,
-    late: bool,
-    files: Vec<(String, Vec<u8>)>,
+pub struct Student {
+    pub full_name: &'static str,
+    pub canvas: &'static str,
+    pub id: &'static str,
+    pub late: bool,
+    pub files: Vec<(String, Vec<u8>)>,
 }
 
-fn png(picture: &RgbImage) -> Vec<u8> {
+pub fn png(picture: &RgbImage) -> Vec<u8> {
     goldray::film::encode_png(picture).unwrap()
 }
 
 /// A zip of `entries` (name, bytes), deflated.
-fn zip_of(entries: &[(String, Vec<u8>)]) -> Vec<u8> {
+pub fn zip_of(entries: &[(String, Vec<u8>)]) -> Vec<u8> {
     let mut zip = ZipWriter::new(Cursor::new(Vec::new()));
     let options = SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
     for (name, bytes) in entries {
@@ -43,7 +43,7 @@ fn zip_of(entries: &[(String, Vec<u8>)]) -> Vec<u8> {
 /// Four students: one perfect, one late with a broken colour picture, one who uploaded a zip of
 /// their own (with a colour picture nearly identical to the late one's), one who named a file
 /// wrong.
-fn students() -> Vec<Student> {
+pub fn students() -> Vec<Student> {
     let [color, normals, depth] = pictures(&render(&case()));
     let mut broken = color.clone();
     for y in 0..40 {
@@ -100,16 +100,16 @@ fn students() -> Vec<Student> {
     ]
 }
 
-fn canvas_name(student: &Student, file: &str) -> String {
+pub fn canvas_name(student: &Student, file: &str) -> String {
     let late = if student.late { "LATE_" } else { "" };
     format!("{}_{late}{}_9{}_{file}", student.canvas, student.id, student.id)
 }
 
-fn moodle_folder(student: &Student) -> String {
+pub fn moodle_folder(student: &Student) -> String {
     format!("{}_{}_assignsubmission_file_", student.full_name, student.id)
 }
 
-fn canvas_zip(students: &[Student]) -> Vec<u8> {
+pub fn canvas_zip(students: &[Student]) -> Vec<u8> {
     zip_of(
         &students
             .iter()
@@ -118,7 +118,7 @@ fn canvas_zip(students: &[Student]) -> Vec<u8> {
     )
 }
 
-fn moodle_zip(students: &[Student]) -> Vec<u8> {
+pub fn moodle_zip(students: &[Student]) -> Vec<u8> {
     let mut entries: Vec<(String, Vec<u8>)> = students
         .iter()
         .flat_map(|s| {
@@ -135,7 +135,7 @@ fn moodle_zip(students: &[Student]) -> Vec<u8> {
 }
 
 /// The class as plain folders, named by full name, each student's own zip extracted.
-fn folders(students: &[Student], dir: &Path) {
+pub fn folders(students: &[Student], dir: &Path) {
     for student in students {
         let folder = dir.join(student.full_name);
         for (file, bytes) in &student.files {
@@ -150,7 +150,7 @@ fn folders(students: &[Student], dir: &Path) {
     }
 }
 
-fn grade(dir: &Path, submissions: &Path, out: &str) -> ClassReport {
+pub fn grade(dir: &Path, submissions: &Path, out: &str) -> ClassReport {
     let options = GradeOptions {
         out: dir.join(out),
         cache: Some(dir.join("cache")),
@@ -160,10 +160,10 @@ fn grade(dir: &Path, submissions: &Path, out: &str) -> ClassReport {
 }
 
 /// A student's platform id, each image's verdict and points, and the total.
-type Score = (String, Vec<(&'static str, f64)>, f64);
+pub type Score = (String, Vec<(&'static str, f64)>, f64);
 
 /// Each student's verdicts and points by platform id (by full name for plain folders).
-fn scores(report: &ClassReport, students: &[Student]) -> Vec<Score> {
+pub fn scores(report: &ClassReport, students: &[Student]) -> Vec<Score> {
     let mut scores: Vec<_> = report
         .students
         .iter()
@@ -183,7 +183,7 @@ fn scores(report: &ClassReport, students: &[Student]) -> Vec<Score> {
     scores
 }
 
-fn setup(extra: &str) -> (tempfile::TempDir, Vec<Student>) {
+pub fn setup(extra: &str) -> (tempfile::TempDir, Vec<Student>) {
     let dir = tempfile::tempdir().unwrap();
     fs::write(dir.path().join("rubric.toml"), rubric_text(&scene_path()) + extra).unwrap();
     (dir, students())
@@ -201,22 +201,29 @@ fn canvas_and_moodle_downloads_grade_like_folders_with_the_platforms_names_and_i
         .unwrap()
         .extract(&extracted)
         .unwrap();
+    let canvas_extracted = dir.join("canvas-extracted");
+    zip::ZipArchive::new(Cursor::new(canvas_zip(&students)))
+        .unwrap()
+        .extract(&canvas_extracted)
+        .unwrap();
 
     let plain = grade(dir, &dir.join("folders"), "plain");
     let canvas = grade(dir, &dir.join("canvas.zip"), "canvas");
     let moodle = grade(dir, &dir.join("moodle.zip"), "moodle");
     let unzipped = grade(dir, &extracted, "unzipped");
+    let canvas_unzipped = grade(dir, &canvas_extracted, "canvas-unzipped");
     assert_eq!(plain.layout, Layout::Folders);
     assert_eq!(canvas.layout, Layout::Canvas);
     assert_eq!(moodle.layout, Layout::Moodle);
     assert_eq!(unzipped.layout, Layout::Moodle);
+    assert_eq!(canvas_unzipped.layout, Layout::Canvas);
     let expected = scores(&plain, &students);
     assert_eq!(expected.len(), 4);
     // The late student lost points on colour, the wrong name costs colour, the own zip is read.
     assert_eq!(expected[1].1[0], ("fail", 0.0));
     assert_eq!(expected[2].1, [("fail", 0.0), ("pass", 1.0), ("pass", 1.0)]);
     assert_eq!(expected[3].1[0], ("missing", 0.0));
-    for report in [&canvas, &moodle, &unzipped] {
+    for report in [&canvas, &moodle, &unzipped, &canvas_unzipped] {
         assert_eq!(scores(report, &students), expected, "{:?}", report.layout);
     }
 
@@ -383,7 +390,7 @@ fn a_zip_resumes_by_student_and_shards_by_student_into_the_same_bytes() {
 }
 
 /// Patches every occurrence of `from` in `bytes` (names in local and central headers).
-fn rename(bytes: &mut [u8], from: &[u8], to: &[u8]) {
+pub fn rename(bytes: &mut [u8], from: &[u8], to: &[u8]) {
     assert_eq!(from.len(), to.len());
     let mut at = 0;
     while let Some(i) = bytes[at..].windows(from.len()).position(|w| w == from) {

@@ -93,6 +93,8 @@ pub struct Archive<R> {
     zip: ZipArchive<R>,
     pub entries: Vec<Entry>,
     pub refused: Vec<Refusal>,
+    /// The names of the folders the archive lists (`a/b/`), which hold nothing to extract.
+    pub folders: Vec<String>,
     limits: Limits,
 }
 
@@ -106,18 +108,24 @@ impl Archive<BufReader<File>> {
 }
 
 impl<R: Read + Seek> Archive<R> {
-    pub fn new(mut reader: R, limits: Limits) -> Result<Archive<R>, String> {
-        let duplicates = match central_names(&mut reader, limits.entries) {
-            Ok(names) => names,
-            Err(e) => return Err(unreadable_archive(&ZipError::Io(e))),
-        };
+    pub fn new(reader: R, limits: Limits) -> Result<Archive<R>, String> {
         let mut zip = ZipArchive::new(reader).map_err(|e| unreadable_archive(&e))?;
-        let (mut entries, mut refused) = (Vec::new(), Vec::new());
-        if zip.len() > limits.entries {
+        let mut duplicates = BTreeMap::new();
+        if zip.has_duplicate_names() {
+            // The zip crate found the central directory (zip64 or not) and says a name repeats,
+            // but keeps one entry per name: which names repeat is read from the directory again.
+            let start = zip.central_directory_start();
+            let mut reader = zip.into_inner();
+            duplicates =
+                central_names(&mut reader, start, limits.entries).map_err(|e| unreadable_archive(&ZipError::Io(e)))?;
+            zip = ZipArchive::new(reader).map_err(|e| unreadable_archive(&e))?;
+        }
+        let count = zip.len().max(duplicates.values().sum());
+        let (mut entries, mut refused, mut folders) = (Vec::new(), Vec::new(), Vec::new());
+        if count > limits.entries {
             return Err(format!(
                 "the archive holds {} entries, over the limit of {} (a zip bomb?): not read",
-                zip.len(),
-                limits.entries
+                count, limits.entries
             ));
         }
         let mut total: u64 = 0;
@@ -138,6 +146,11 @@ impl<R: Read + Seek> Archive<R> {
                     reason: "a symbolic link in the archive: not read".to_owned(),
                 })
             } else if file.is_dir() {
+                // Nothing is written for a folder, but it may be a student who handed in nothing
+                // (Moodle's folder of a participant without files).
+                if !leaves_folder(&name) {
+                    folders.push(name);
+                }
                 continue;
             } else if leaves_folder(&name) || file.enclosed_name().is_none() {
                 Some(unreadable(
@@ -190,6 +203,7 @@ impl<R: Read + Seek> Archive<R> {
             zip,
             entries,
             refused,
+            folders,
             limits,
         })
     }
@@ -232,43 +246,22 @@ impl<R: Read + Seek> Archive<R> {
     }
 }
 
-/// How many times each name appears in the central directory. The zip crate keeps one entry
-/// per name, so a second entry of the same name would otherwise go unseen.
-fn central_names<R: Read + Seek>(reader: &mut R, limit: usize) -> io::Result<BTreeMap<Vec<u8>, usize>> {
-    let end = reader.seek(SeekFrom::End(0))?;
-    // The end-of-central-directory record: 22 bytes and a comment of at most 65,535.
-    let tail_len = end.min(22 + 65_535);
-    reader.seek(SeekFrom::Start(end - tail_len))?;
-    let mut tail = vec![0; tail_len as usize];
-    reader.read_exact(&mut tail)?;
-    let mut names = BTreeMap::new();
-    let Some(at) = (0..tail.len().saturating_sub(21))
-        .rev()
-        .find(|&i| tail[i..i + 4] == [0x50, 0x4b, 0x05, 0x06])
-    else {
-        // No record: the zip crate will say so.
-        return Ok(names);
-    };
-    let start = u64::from(u32::from_le_bytes([
-        tail[at + 16],
-        tail[at + 17],
-        tail[at + 18],
-        tail[at + 19],
-    ]));
-    if start == u64::from(u32::MAX) || start >= end {
-        // Zip64 or damaged: leave it to the zip crate, which reads both.
-        return Ok(names);
-    }
+/// How many times each name appears in the central directory that starts at `start`, counting at
+/// most `limit + 1` entries. The zip crate keeps one entry per name, so a second entry of the same
+/// name would otherwise go unseen; it has found where the directory starts (in a zip64 archive
+/// too), and a central header is laid out alike in both: only its name and lengths are read here.
+fn central_names<R: Read + Seek>(reader: &mut R, start: u64, limit: usize) -> io::Result<BTreeMap<Vec<u8>, usize>> {
     reader.seek(SeekFrom::Start(start))?;
+    let mut names = BTreeMap::new();
     let mut header = [0u8; 46];
     for _ in 0..=limit {
         if reader.read_exact(&mut header).is_err() || header[..4] != [0x50, 0x4b, 0x01, 0x02] {
             break;
         }
-        let length = |at: usize| i64::from(u16::from_le_bytes([header[at], header[at + 1]]));
-        let mut name = vec![0; length(28) as usize];
+        let length = |at: usize| u16::from_le_bytes([header[at], header[at + 1]]);
+        let mut name = vec![0; usize::from(length(28))];
         reader.read_exact(&mut name)?;
-        reader.seek(SeekFrom::Current(length(30) + length(32)))?;
+        reader.seek(SeekFrom::Current(i64::from(length(30)) + i64::from(length(32))))?;
         *names.entry(name).or_default() += 1;
     }
     Ok(names)

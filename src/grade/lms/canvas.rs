@@ -39,6 +39,20 @@ pub fn parse(file_name: &str) -> Option<CanvasFile<'_>> {
     })
 }
 
+/// Canvas's mark of a file uploaded again: `-N` before the extension of the name (`a01-1.png` for a
+/// second `a01.png`, `a01-2.png` for a third), N a positive number without leading zeros. The name
+/// as uploaded and N, or `None` for a name without the mark.
+pub fn resubmission(original: &str) -> Option<(String, u32)> {
+    let (stem, extension) = match original.rfind('.') {
+        Some(at) if at > 0 => original.split_at(at),
+        _ => (original, ""),
+    };
+    let (base, n) = stem.rsplit_once('-')?;
+    let digits = !n.starts_with('0') && n.bytes().all(|b| b.is_ascii_digit());
+    let n: u32 = n.parse().ok().filter(|_| digits && !base.is_empty())?;
+    Some((format!("{base}{extension}"), n))
+}
+
 /// The gradebook import's identifying columns; the assignment's column follows them.
 pub const IDENTITY_COLUMNS: [&str; 5] = ["Student", "ID", "SIS User ID", "SIS Login ID", "Section"];
 
@@ -87,5 +101,24 @@ mod tests {
         assert_eq!(parse("a01.png"), None);
         assert_eq!(parse("smith_x12_3_a.png"), None);
         assert_eq!(parse("smith_12_3_"), None);
+    }
+
+    #[test]
+    fn a_resubmission_mark_is_a_positive_number_before_the_extension() {
+        assert_eq!(resubmission("a01-1.png"), Some(("a01.png".to_owned(), 1)));
+        assert_eq!(resubmission("my-render-12.png"), Some(("my-render.png".to_owned(), 12)));
+        assert_eq!(resubmission("notes-2"), Some(("notes".to_owned(), 2)));
+        for name in [
+            "a01.png",
+            "a01-0.png",
+            "a01-01.png",
+            "a01-.png",
+            "-1.png",
+            "a01-x.png",
+            "a01-1a.png",
+        ] {
+            assert_eq!(resubmission(name), None, "{name}");
+        }
+        assert_eq!(resubmission("a01-99999999999.png"), None, "beyond u32: not Canvas's");
     }
 }

@@ -3,17 +3,19 @@
 //!
 //! [`read_class`] finds the students and their files without extracting anything: a plain
 //! folder's students are its folders, as ever; a download's students are found by the names the
-//! platform gives (see `canvas` and `moodle`), each with their name and id on the platform. A
+//! platform gives (see `canvas` and `moodle`), each with their name and id on the platform, and
+//! the names Canvas changes when a file is uploaded again given back (see `resubmission`). A
 //! student whose files are not a folder of their own is [`stage`]d just before grading: their
 //! files copied (out of the archive, with its checks) into a folder of a temporary directory,
 //! their own zips expanded beside them, and the report told where each file came from.
 
 mod archive;
 pub mod canvas;
+mod found;
 pub mod moodle;
+mod resubmission;
 mod stage;
 
-use std::collections::BTreeMap;
 use std::fs;
 use std::io;
 use std::path::{Path, PathBuf};
@@ -22,6 +24,8 @@ use serde::{Deserialize, Serialize};
 
 pub use archive::{Limits, Refusal};
 pub use stage::{Staged, stage};
+
+use found::{Found, placement};
 
 /// How the submissions were laid out.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize, Deserialize)]
@@ -93,7 +97,8 @@ pub struct Student {
     pub source: Source,
     /// Where the student's files are, for the report.
     pub shown: PathBuf,
-    /// Their archive entries that were refused, under the names they would have had.
+    /// Their archive entries that were refused, under the names they would have had, and their
+    /// Canvas uploads that a newer one of the same name superseded, under their download names.
     pub refused: Vec<(PathBuf, Refusal)>,
 }
 
@@ -116,10 +121,11 @@ pub fn is_archive(path: &Path) -> bool {
 }
 
 /// The class in `submissions` (a folder or a `.zip`), skipping hidden entries, `__MACOSX` and
-/// the folders of `own` (the report, the cache).
-pub fn read_class(submissions: &Path, own: &[&PathBuf], limits: Limits) -> io::Result<Class> {
+/// the folders of `own` (the report, the cache). `expected` are the file names the rubric
+/// expects, which decide whether Canvas's `a01-1.png` is given back its name `a01.png`.
+pub fn read_class(submissions: &Path, own: &[&PathBuf], expected: &[&str], limits: Limits) -> io::Result<Class> {
     if is_archive(submissions) {
-        return read_archive(submissions, limits);
+        return read_archive(submissions, expected, limits);
     }
     let own: Vec<PathBuf> = own.iter().filter_map(|p| p.canonicalize().ok()).collect();
     let mut entries: Vec<(String, PathBuf, bool)> = Vec::new();
@@ -142,21 +148,29 @@ pub fn read_class(submissions: &Path, own: &[&PathBuf], limits: Limits) -> io::R
             found.folder(&name, &path);
             continue;
         }
-        let mut files = Vec::new();
-        if is_dir {
-            walk(&path, Path::new(""), 0, &mut files);
-        } else {
-            files.push(PathBuf::new());
-        }
         let mut placed = false;
-        for relative in files {
-            let within = Path::new(&name).join(&relative);
-            let within = within.to_string_lossy();
-            if let Some(place) = placement(layout, within.trim_end_matches('/'), submissions) {
+        if is_dir && let Some(place) = placement(layout, &format!("{name}/"), submissions) {
+            found.enrol(&place);
+            placed = true;
+        }
+        // Each file as the download names it (`folder/file` or `file`), and where it is. A top
+        // file is `path` itself: `path.join("")` would be `path/`, which no file can be opened as.
+        let files: Vec<(PathBuf, PathBuf)> = if is_dir {
+            let mut relative = Vec::new();
+            walk(&path, Path::new(""), 0, &mut relative);
+            relative
+                .iter()
+                .map(|r| (Path::new(&name).join(r), path.join(r)))
+                .collect()
+        } else {
+            vec![(PathBuf::from(&name), path.clone())]
+        };
+        for (within, file) in files {
+            if let Some(place) = placement(layout, &within.to_string_lossy(), submissions) {
                 let item = Item {
                     path: PathBuf::from(place.relative),
-                    origin: Origin::File(path.join(&relative)),
-                    shown: path.join(&relative).display().to_string(),
+                    shown: file.display().to_string(),
+                    origin: Origin::File(file),
                 };
                 found.add(&place, item);
                 placed = true;
@@ -166,7 +180,7 @@ pub fn read_class(submissions: &Path, own: &[&PathBuf], limits: Limits) -> io::R
             found.ignored.push(name);
         }
     }
-    Ok(found.class(layout, None, Vec::new()))
+    Ok(found.class(layout, None, Vec::new(), expected))
 }
 
 /// Hidden entries and macOS archive litter.
@@ -184,12 +198,6 @@ fn detect(top: &[(String, bool)]) -> Layout {
         (m, c) if m >= c => Layout::Moodle,
         _ => Layout::Canvas,
     }
-}
-
-/// A Canvas student's files have no folder: the report shows the pattern they share.
-fn canvas_folder(root: &Path, file: &canvas::CanvasFile) -> PathBuf {
-    let late = if file.late { "LATE_" } else { "" };
-    root.join(format!("{}_{late}{}_*", file.name, file.user_id))
 }
 
 /// The files under `dir`, relative to it, at most three levels down, links included as files
@@ -219,15 +227,17 @@ fn walk(root: &Path, relative: &Path, depth: usize, files: &mut Vec<PathBuf>) {
 }
 
 /// A class archive: its entries sorted into students by the layout their names follow.
-fn read_archive(path: &Path, limits: Limits) -> io::Result<Class> {
+fn read_archive(path: &Path, expected: &[&str], limits: Limits) -> io::Result<Class> {
     let archive = archive::Archive::open(path, limits)
         .map_err(|reason| io::Error::new(io::ErrorKind::InvalidData, format!("{}: {reason}", path.display())))?;
     let shown = |name: &str| format!("{}/{name}", path.display());
     let mut top: Vec<(String, bool)> = archive
         .entries
         .iter()
-        .map(|e| {
-            let mut parts = e.name.splitn(2, '/');
+        .map(|e| &e.name)
+        .chain(&archive.folders)
+        .map(|name| {
+            let mut parts = name.splitn(2, '/');
             let first = parts.next().unwrap_or_default().to_owned();
             (first, parts.next().is_some())
         })
@@ -253,6 +263,12 @@ fn read_archive(path: &Path, limits: Limits) -> io::Result<Class> {
             None => {}
         }
     }
+    for folder in &archive.folders {
+        let name = format!("{}/", folder.split('/').next().unwrap_or_default());
+        if let Some(place) = placement(layout, &name, path) {
+            found.enrol(&place);
+        }
+    }
     let mut refused = Vec::new();
     for refusal in &archive.refused {
         match placement(layout, &refusal.entry, path) {
@@ -260,148 +276,5 @@ fn read_archive(path: &Path, limits: Limits) -> io::Result<Class> {
             None => refused.push(refusal.clone()),
         }
     }
-    Ok(found.class(layout, Some(path.to_path_buf()), refused))
-}
-
-/// Whose file an archive entry is, under what name.
-struct Placement<'a> {
-    name: &'a str,
-    platform: Layout,
-    id: &'a str,
-    late: bool,
-    /// Where the student's files are, for the report.
-    folder: PathBuf,
-    /// The file's name in the student's folder.
-    relative: &'a str,
-}
-
-/// The student an entry named `name` of the archive at `archive` belongs to in `layout`.
-fn placement<'a>(layout: Layout, name: &'a str, archive: &Path) -> Option<Placement<'a>> {
-    let (first, rest) = match name.split_once('/') {
-        Some((first, rest)) => (first, Some(rest)),
-        None => (name, None),
-    };
-    if skipped(first) {
-        return None;
-    }
-    match (layout, rest) {
-        (Layout::Folders, Some(rest)) => Some(Placement {
-            name: first,
-            platform: Layout::Folders,
-            id: "",
-            late: false,
-            folder: archive.join(first),
-            relative: rest,
-        }),
-        (Layout::Moodle, _) => {
-            let m = moodle::parse(first)?;
-            let relative = rest.unwrap_or(m.rest);
-            let folder = &first[..first.len() - m.rest.len()];
-            (!relative.is_empty()).then(|| Placement {
-                name: m.full_name,
-                platform: Layout::Moodle,
-                id: m.participant,
-                late: false,
-                folder: archive.join(folder),
-                relative,
-            })
-        }
-        (Layout::Canvas, None) => {
-            let c = canvas::parse(first)?;
-            Some(Placement {
-                name: c.name,
-                platform: Layout::Canvas,
-                id: c.user_id,
-                late: c.late,
-                folder: canvas_folder(archive, &c),
-                relative: c.original,
-            })
-        }
-        _ => None,
-    }
-}
-
-/// Students as they are found, grouped by their id on the platform (a folder's name for plain
-/// folders).
-#[derive(Default)]
-struct Found {
-    students: BTreeMap<(Layout, String), Student>,
-    ignored: Vec<String>,
-}
-
-impl Found {
-    fn folder(&mut self, name: &str, path: &Path) {
-        let student = Student {
-            name: name.to_owned(),
-            lms: None,
-            source: Source::Folder(path.to_path_buf()),
-            shown: path.to_path_buf(),
-            refused: Vec::new(),
-        };
-        self.students.insert((Layout::Folders, name.to_owned()), student);
-    }
-
-    /// The student `place` names, made on first sight.
-    fn student(&mut self, place: &Placement) -> &mut Student {
-        let key = match place.platform {
-            Layout::Folders => place.name,
-            _ => place.id,
-        };
-        let student = self
-            .students
-            .entry((place.platform, key.to_owned()))
-            .or_insert_with(|| Student {
-                name: place.name.to_owned(),
-                lms: (place.platform != Layout::Folders).then(|| LmsId {
-                    platform: place.platform,
-                    id: place.id.to_owned(),
-                    late: false,
-                }),
-                source: Source::Files(Vec::new()),
-                shown: place.folder.clone(),
-                refused: Vec::new(),
-            });
-        if let Some(lms) = &mut student.lms {
-            lms.late |= place.late;
-        }
-        student
-    }
-
-    fn add(&mut self, place: &Placement, item: Item) {
-        if let Source::Files(items) = &mut self.student(place).source {
-            items.push(item);
-        }
-    }
-
-    fn refuse(&mut self, place: &Placement, refusal: Refusal) {
-        let relative = PathBuf::from(place.relative);
-        self.student(place).refused.push((relative, refusal));
-    }
-
-    /// The class, students sorted by name then id, names made distinct by their id.
-    fn class(self, layout: Layout, archive: Option<PathBuf>, refused: Vec<Refusal>) -> Class {
-        let mut students: Vec<Student> = self.students.into_values().collect();
-        let id = |s: &Student| s.lms.as_ref().map(|l| l.id.clone()).unwrap_or_default();
-        students.sort_by(|a, b| a.name.cmp(&b.name).then_with(|| id(a).cmp(&id(b))));
-        let mut counts: BTreeMap<String, usize> = BTreeMap::new();
-        for student in &students {
-            *counts.entry(student.name.clone()).or_default() += 1;
-        }
-        for student in &mut students {
-            if counts[&student.name] > 1
-                && let Some(lms) = &student.lms
-            {
-                student.name = format!("{} ({})", student.name, lms.id);
-            }
-        }
-        let mut ignored = self.ignored;
-        ignored.sort();
-        Class {
-            layout,
-            archive,
-            students,
-            ignored,
-            refused,
-        }
-    }
+    Ok(found.class(layout, Some(path.to_path_buf()), refused, expected))
 }

@@ -10,7 +10,7 @@
 use std::collections::BTreeMap;
 use std::fs::{self, File};
 use std::io::{self, Read};
-use std::path::{Path, PathBuf};
+use std::path::{Component, Path, PathBuf};
 
 use super::archive::{Archive, Limits, Refusal};
 use super::{Item, Origin};
@@ -44,6 +44,14 @@ pub fn stage(items: &[Item], class: Option<&Path>, root: &Path, limits: Limits) 
         ));
     };
     for item in items {
+        // A name from a download is data: `..` or `.` (Canvas's `smithjohn_1_2_..`, or one
+        // restored from `.-1.`) would be the folder above or the folder itself, never a file.
+        let plain = |c: Component| matches!(c, Component::Normal(_));
+        if item.path.as_os_str().is_empty() || !item.path.components().all(plain) {
+            let outcome = unreadable("its name is not a file's name (empty, . or ..): not read");
+            refuse(&mut staged, &item.path, &item.shown, outcome);
+            continue;
+        }
         let target = root.join(&item.path);
         let copied = match &item.origin {
             Origin::Entry(index) => {
@@ -166,5 +174,45 @@ fn copy_file(from: &Path, to: &Path, limits: Limits) -> Result<(), Outcome> {
 fn unreadable(reason: &str) -> Outcome {
     Outcome::Unreadable {
         reason: reason.to_owned(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_name_that_is_not_a_file_name_is_refused_and_nothing_is_written_outside() {
+        let dir = tempfile::tempdir().unwrap();
+        let source = dir.path().join("source.png");
+        fs::write(&source, b"png").unwrap();
+        let item = |path: &str| Item {
+            path: PathBuf::from(path),
+            origin: Origin::File(source.clone()),
+            shown: format!("download/smithjohn_1_2_{path}"),
+        };
+        let root = dir.path().join("staging/smithjohn");
+        let staged = stage(
+            &[item(".."), item("."), item(""), item("a/../../b.png"), item("a01.png")],
+            None,
+            &root,
+            Limits::default(),
+        );
+        assert_eq!(staged.refused.len(), 4, "{:?}", staged.refused);
+        assert!(
+            staged
+                .refused
+                .iter()
+                .all(|(_, r)| r.note().contains("not a file's name"))
+        );
+        assert_eq!(staged.shown.keys().collect::<Vec<_>>(), [Path::new("a01.png")]);
+        let mut written: Vec<_> = fs::read_dir(dir.path())
+            .unwrap()
+            .flatten()
+            .map(|e| e.file_name())
+            .collect();
+        written.sort();
+        assert_eq!(written, ["source.png", "staging"]);
+        assert_eq!(fs::read_dir(dir.path().join("staging")).unwrap().count(), 1);
     }
 }
