@@ -56,7 +56,7 @@ fn a_zip64_archive_with_a_name_twice_refuses_both_copies_and_grades_the_rest() {
     entries.push(("mallorymal_105_9105_color.png".to_owned(), ada[0].1.clone()));
     entries.push((
         "mallorymal_105_9105_colox.png".to_owned(),
-        crate::lms::png(&image::RgbImage::new(100, 100)),
+        crate::lms::png(&goldray::rgb_image::RgbImage::new(100, 100)),
     ));
     entries.push(("mallorymal_105_9105_normals.png".to_owned(), ada[1].1.clone()));
     let mut bytes = zip64_of(&entries);
