@@ -45,13 +45,15 @@ pub fn grade(
     let rubric = load_rubric(rubric_path)?;
     let cache = options.cache.clone().unwrap_or_else(default_cache_dir);
     let expected: Vec<&str> = rubric.images.iter().map(|spec| spec.file.as_str()).collect();
-    let class = read_class(submissions, &[&options.out, &cache], &expected, Limits::default()).map_err(|source| {
-        GradeError::Submissions {
-            path: submissions.to_path_buf(),
-            source,
-        }
-    })?;
-    grade_listed(rubric, started, submissions, class, options, diagnose, progress)
+    let class = read_class(submissions, &[&options.out, &cache], &expected, Limits::default())
+        .map_err(submissions_error(submissions))?;
+    let listed = Listed {
+        rubric,
+        started,
+        submissions,
+        class,
+    };
+    grade_listed(listed, options, diagnose, progress)
 }
 
 /// One student's folder graded as a class of one named `name`: what a student's self-check and
@@ -67,10 +69,8 @@ pub fn grade_one(
     let started = Instant::now();
     let rubric = load_rubric(rubric_path)?;
     if !folder.is_dir() {
-        return Err(GradeError::Submissions {
-            path: folder.to_path_buf(),
-            source: std::io::Error::new(std::io::ErrorKind::NotADirectory, "not a folder"),
-        });
+        let not_a_folder = std::io::Error::new(std::io::ErrorKind::NotADirectory, "not a folder");
+        return Err(submissions_error(folder)(not_a_folder));
     }
     let class = Class {
         layout: Layout::Folders,
@@ -85,19 +85,45 @@ pub fn grade_one(
         ignored: Vec::new(),
         refused: Vec::new(),
     };
-    grade_listed(rubric, started, folder, class, options, diagnose, progress)
+    let listed = Listed {
+        rubric,
+        started,
+        submissions: folder,
+        class,
+    };
+    grade_listed(listed, options, diagnose, progress)
+}
+
+/// What a class is graded from: the rubric, the students found and where, and when grading
+/// started (the report's time includes reading the rubric and the class).
+struct Listed<'a> {
+    rubric: Rubric,
+    started: Instant,
+    submissions: &'a Path,
+    class: Class,
+}
+
+/// The error of a submissions folder or download that cannot be read (or staged from).
+fn submissions_error(path: &Path) -> impl FnOnce(std::io::Error) -> GradeError + '_ {
+    move |source| GradeError::Submissions {
+        path: path.to_path_buf(),
+        source,
+    }
 }
 
 /// Grades the students of `class`, read from `submissions`.
 fn grade_listed(
-    rubric: Rubric,
-    started: Instant,
-    submissions: &Path,
-    class: Class,
+    listed: Listed,
     options: &GradeOptions,
     diagnose: Diagnose,
     progress: &dyn Progress,
 ) -> Result<ClassReport, GradeError> {
+    let Listed {
+        rubric,
+        started,
+        submissions,
+        class,
+    } = listed;
     let out = &options.out;
     let cache = options.cache.clone().unwrap_or_else(default_cache_dir);
     // A download's students are staged here, one folder each, while they are graded.
@@ -106,10 +132,7 @@ fn grade_listed(
             tempfile::Builder::new()
                 .prefix("goldray-grade-")
                 .tempdir()
-                .map_err(|source| GradeError::Submissions {
-                    path: submissions.to_path_buf(),
-                    source,
-                })?,
+                .map_err(submissions_error(submissions))?,
         )
     } else {
         None
@@ -146,10 +169,8 @@ fn grade_listed(
                     Source::Files(items) => {
                         // Made above whenever a student has files to stage.
                         let Some(staging) = &staging else {
-                            return Err(GradeError::Submissions {
-                                path: submissions.to_path_buf(),
-                                source: std::io::Error::other("no folder to stage a download's files in"),
-                            });
+                            let no_staging = std::io::Error::other("no folder to stage a download's files in");
+                            return Err(submissions_error(submissions)(no_staging));
                         };
                         let root = staging.path().join(&slugs[i]);
                         let mut staged = stage(items, class.archive.as_deref(), &root, Limits::default());
