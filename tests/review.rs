@@ -3,8 +3,9 @@
 //! (insta's binary snapshot under the tolerance comparator, with insta's own file handling) in a
 //! child process of this test binary, where `INSTA_UPDATE` can be set; it fails and leaves
 //! insta's pending snapshot. Then the page is opened in headless Chromium and driven over the
-//! DevTools protocol: a real click on Accept or Reject (`clicks`); the files are compared byte
-//! for byte with what insta's own accept code writes from the same pending snapshot.
+//! DevTools protocol: a real click on Accept or Reject (`clicks`), the inspector's controls used
+//! with the mouse and keyboard (`controls`); the files are compared byte for byte with what
+//! insta's own accept code writes from the same pending snapshot.
 
 // Shared with tests/grade.rs and tests/diagnose.rs.
 #[allow(dead_code)]
@@ -22,6 +23,8 @@ mod util;
 mod cdp;
 #[path = "review/clicks.rs"]
 mod clicks;
+#[path = "review/controls.rs"]
+mod controls;
 #[path = "review/served.rs"]
 mod served;
 

@@ -210,6 +210,42 @@ impl Browser {
         );
     }
 
+    /// One notch of the mouse wheel at `(x, y)`, away from the user (`up`) or towards them.
+    pub fn wheel(&mut self, x: f64, y: f64, up: bool) {
+        let delta = if up { -120 } else { 120 };
+        self.call(
+            "Input.dispatchMouseEvent",
+            json!({ "type": "mouseWheel", "x": x, "y": y, "deltaX": 0, "deltaY": delta }),
+        );
+    }
+
+    /// Presses and releases a key: `Tab`, `Home`, `End`, an arrow or a letter.
+    pub fn press(&mut self, key: &str) {
+        let (code, virtual_key) = match key {
+            "Tab" => (key.to_owned(), 9),
+            "End" => (key.to_owned(), 35),
+            "Home" => (key.to_owned(), 36),
+            "ArrowLeft" => (key.to_owned(), 37),
+            "ArrowUp" => (key.to_owned(), 38),
+            "ArrowRight" => (key.to_owned(), 39),
+            "ArrowDown" => (key.to_owned(), 40),
+            letter if letter.len() == 1 && letter.as_bytes()[0].is_ascii_alphabetic() => {
+                let upper = letter.to_ascii_uppercase();
+                (format!("Key{upper}"), u32::from(upper.as_bytes()[0]))
+            }
+            other => panic!("no key code for `{other}`"),
+        };
+        let mut down = json!({ "type": "keyDown", "key": key, "code": code, "windowsVirtualKeyCode": virtual_key });
+        if key.len() == 1 {
+            down["text"] = json!(key);
+        }
+        self.call("Input.dispatchKeyEvent", down);
+        self.call(
+            "Input.dispatchKeyEvent",
+            json!({ "type": "keyUp", "key": key, "code": code, "windowsVirtualKeyCode": virtual_key }),
+        );
+    }
+
     /// What the window shows now, written to `file` as a PNG.
     pub fn screenshot(&mut self, file: &Path) -> goldray::rgb_image::RgbImage {
         let shot = self.call("Page.captureScreenshot", json!({ "format": "png" }));
