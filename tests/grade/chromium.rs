@@ -16,7 +16,7 @@ pub fn chromium() -> PathBuf {
     let path = PathBuf::from(CHROMIUM);
     assert!(
         path.exists(),
-        "{CHROMIUM} is missing: the HTML report test needs Debian's chromium \
+        "{CHROMIUM} is missing: the tests that open pages need Debian's chromium \
          (`apt-get install -y chromium`; .ci/run installs it)"
     );
     path
