@@ -25,6 +25,17 @@ use crate::chromium;
 /// machine is a few seconds; a minute means something hangs.
 const TIMEOUT: Duration = Duration::from_secs(60);
 
+/// How many times [`Browser::open`] starts a Chromium that died before its first answer.
+const STARTS: u32 = 3;
+
+/// Why a command has no result.
+enum NoAnswer {
+    /// The protocol's error: the command was refused.
+    Refused(String),
+    /// Chromium closed its pipe: how it ended and its last words.
+    Gone(String),
+}
+
 /// A headless Chromium with one tab, attached.
 pub struct Browser {
     child: Child,
@@ -34,14 +45,43 @@ pub struct Browser {
     next_id: u64,
     /// The tab's session, once attached: commands to the page carry it.
     session: Option<String>,
-    _profile: tempfile::TempDir,
+    /// The profile (`profile/`) and what Chromium writes on stderr (`stderr.log`).
+    dir: tempfile::TempDir,
 }
 
 impl Browser {
     /// Starts Chromium in a `width`×`height` window, opens `url` in a new tab and waits until
     /// the document has loaded and the page's own `ready` expression is true.
     pub fn open(url: &str, width: u32, height: u32, ready: &str) -> Browser {
-        let profile = tempfile::tempdir().expect("a profile folder");
+        // Chromium now and then dies of SIGSEGV before it answers anything when several start at
+        // once on a busy machine (seen with nine at a time on two cores). Nothing of the page has
+        // run by then, so such a start is tried again, a bounded number of times.
+        let mut starts = 1;
+        let (mut browser, target) = loop {
+            let mut browser = Browser::start(width, height);
+            match browser.send("Target.createTarget", json!({ "url": "about:blank" })) {
+                Ok(target) => break (browser, target),
+                Err(NoAnswer::Gone(why)) if starts < STARTS => eprintln!("chromium died at start: {why}"),
+                Err(NoAnswer::Gone(why) | NoAnswer::Refused(why)) => {
+                    panic!("chromium failed at start ({starts} tries), the last time: {why}")
+                }
+            }
+            starts += 1;
+        };
+        let attached = browser.call(
+            "Target.attachToTarget",
+            json!({ "targetId": target["targetId"], "flatten": true }),
+        );
+        browser.session = Some(attached["sessionId"].as_str().expect("a session id").to_owned());
+        browser.call("Page.enable", json!({}));
+        browser.navigate(url, ready);
+        browser
+    }
+
+    /// Chromium started with the pipes on its descriptors 3 and 4, before any command.
+    fn start(width: u32, height: u32) -> Browser {
+        let dir = tempfile::tempdir().expect("a folder for the profile");
+        let stderr = File::create(dir.path().join("stderr.log")).expect("a log file");
         // Close-on-exec in this process, so that no other child started meanwhile (tests run in
         // parallel) holds an end open; only the two ends moved to 3 and 4 reach Chromium.
         let pipe = || rustix::pipe::pipe_with(rustix::pipe::PipeFlags::CLOEXEC).expect("a pipe");
@@ -52,32 +92,23 @@ impl Browser {
         command
             .args(chromium::FLAGS)
             .args(["--remote-debugging-pipe", &format!("--window-size={width},{height}")])
-            .arg(format!("--user-data-dir={}", profile.path().display()))
+            .arg(format!("--user-data-dir={}", dir.path().join("profile").display()))
             .stdin(Stdio::null())
             .stdout(Stdio::null())
-            .stderr(Stdio::null());
+            .stderr(stderr);
         // SAFETY: between fork and exec the closure calls only fcntl and dup2, which are
         // async-signal-safe, and allocates nothing.
         unsafe { command.pre_exec(move || onto_3_and_4(fds)) };
         let child = command.spawn().expect("chromium starts");
         drop((its_commands, its_messages));
-        let mut browser = Browser {
+        Browser {
             child,
             commands: File::from(commands),
             messages: read_messages(messages),
             next_id: 0,
             session: None,
-            _profile: profile,
-        };
-        let target = browser.call("Target.createTarget", json!({ "url": "about:blank" }));
-        let attached = browser.call(
-            "Target.attachToTarget",
-            json!({ "targetId": target["targetId"], "flatten": true }),
-        );
-        browser.session = Some(attached["sessionId"].as_str().expect("a session id").to_owned());
-        browser.call("Page.enable", json!({}));
-        browser.navigate(url, ready);
-        browser
+            dir,
+        }
     }
 
     /// Opens `url` in the tab and waits until the document has loaded and `ready` is true
@@ -94,13 +125,16 @@ impl Browser {
     /// Sends one command (to the tab, once attached) and returns its result.
     fn call(&mut self, method: &str, params: Value) -> Value {
         let sent = params.to_string();
-        self.send(method, params)
-            .unwrap_or_else(|error| panic!("chromium refused {method} {sent}: {error}"))
+        match self.send(method, params) {
+            Ok(result) => result,
+            Err(NoAnswer::Refused(error)) => panic!("chromium refused {method} {sent}: {error}"),
+            Err(NoAnswer::Gone(why)) => panic!("chromium closed its pipe awaiting {method}: {why}"),
+        }
     }
 
-    /// [`Browser::call`], with the protocol's error as an `Err`: a page that is navigating
-    /// refuses an evaluation, which a wait takes as "not yet".
-    fn send(&mut self, method: &str, params: Value) -> Result<Value, String> {
+    /// Sends one command and waits for its answer, passing over events (which nothing here
+    /// awaits); panics when none comes within [`TIMEOUT`].
+    fn send(&mut self, method: &str, params: Value) -> Result<Value, NoAnswer> {
         self.next_id += 1;
         let id = self.next_id;
         let mut message = json!({ "id": id, "method": method, "params": params });
@@ -109,8 +143,8 @@ impl Browser {
         }
         let mut bytes = message.to_string().into_bytes();
         bytes.push(0);
-        if let Err(e) = self.commands.write_all(&bytes) {
-            panic!("sending {method} to chromium: {e}");
+        if self.commands.write_all(&bytes).is_err() {
+            return Err(NoAnswer::Gone(self.last_words()));
         }
         let deadline = Instant::now() + TIMEOUT;
         loop {
@@ -120,13 +154,15 @@ impl Browser {
             {
                 Ok(Ok(reply)) => reply,
                 Ok(Err(e)) => panic!("awaiting the answer to {method}: {e}"),
-                Err(RecvTimeoutError::Timeout) => panic!("chromium did not answer {method} within {TIMEOUT:?}"),
-                Err(RecvTimeoutError::Disconnected) => panic!("chromium closed its pipe awaiting {method}"),
+                Err(RecvTimeoutError::Timeout) => panic!(
+                    "chromium did not answer {method} within {TIMEOUT:?}: {}",
+                    self.last_words()
+                ),
+                Err(RecvTimeoutError::Disconnected) => return Err(NoAnswer::Gone(self.last_words())),
             };
-            // Events (no id) are not awaited by anything here.
             if reply["id"] == id {
                 return match reply.get("error") {
-                    Some(error) => Err(error.to_string()),
+                    Some(error) => Err(NoAnswer::Refused(error.to_string())),
                     None => Ok(reply["result"].clone()),
                 };
             }
@@ -140,12 +176,15 @@ impl Browser {
             .unwrap_or_else(|error| panic!("`{expression}`: {error}"))
     }
 
-    /// [`Browser::eval`], with what it threw (or why it could not run) as an `Err`.
+    /// [`Browser::eval`], with what it threw (or why the page could not run it: it is being
+    /// replaced) as an `Err`.
     fn try_eval(&mut self, expression: &str) -> Result<Value, String> {
-        let result = self.send(
-            "Runtime.evaluate",
-            json!({ "expression": expression, "returnByValue": true, "awaitPromise": true }),
-        )?;
+        let params = json!({ "expression": expression, "returnByValue": true, "awaitPromise": true });
+        let result = match self.send("Runtime.evaluate", params) {
+            Ok(result) => result,
+            Err(NoAnswer::Refused(error)) => return Err(error),
+            Err(NoAnswer::Gone(why)) => panic!("chromium closed its pipe evaluating `{expression}`: {why}"),
+        };
         match result.get("exceptionDetails") {
             Some(exception) => Err(format!("threw {}", exception["exception"]["description"])),
             None => Ok(result["result"]["value"].clone()),
@@ -246,12 +285,28 @@ impl Browser {
         );
     }
 
-    /// What the window shows now, written to `file` as a PNG.
+    /// What the window shows now, also written to `file` as a PNG for a person to look at.
     pub fn screenshot(&mut self, file: &Path) -> goldray::rgb_image::RgbImage {
         let shot = self.call("Page.captureScreenshot", json!({ "format": "png" }));
         let png = base64_decode(shot["data"].as_str().expect("the screenshot's data"));
-        std::fs::write(file, png).unwrap_or_else(|e| panic!("writing {}: {e}", file.display()));
-        goldray::rgb_image::read_png(file).unwrap_or_else(|e| panic!("{e}"))
+        std::fs::write(file, &png).unwrap_or_else(|e| panic!("writing {}: {e}", file.display()));
+        // Decoded from memory: another run of the same test may be writing the same file.
+        match goldray::rgb_image::decode_png(&png, u64::MAX) {
+            Ok(decoded) => decoded.image,
+            Err(e) => panic!("the screenshot: {e}"),
+        }
+    }
+
+    /// Whether Chromium still runs, and the end of what it wrote on stderr: why it went quiet.
+    fn last_words(&mut self) -> String {
+        let status = match self.child.try_wait() {
+            Ok(Some(status)) => format!("it exited ({status})"),
+            _ => "it still runs".to_owned(),
+        };
+        let log = std::fs::read_to_string(self.dir.path().join("stderr.log")).unwrap_or_default();
+        let lines: Vec<&str> = log.lines().collect();
+        let tail = lines[lines.len().saturating_sub(20)..].join("\n");
+        format!("{status}; the end of its stderr:\n{tail}")
     }
 }
 
