@@ -242,6 +242,7 @@ impl Browser {
         }
     }
 
+    /// Moves the mouse to `(x, y)`, in the window's CSS pixels.
     pub fn move_to(&mut self, x: f64, y: f64) {
         self.call(
             "Input.dispatchMouseEvent",
@@ -249,24 +250,21 @@ impl Browser {
         );
     }
 
-    /// One notch of the mouse wheel at `(x, y)`, away from the user (`up`) or towards them.
-    pub fn wheel(&mut self, x: f64, y: f64, up: bool) {
-        let delta = if up { -120 } else { 120 };
+    /// One notch of the mouse wheel at `(x, y)`, turned away from the user (up).
+    pub fn wheel_up(&mut self, x: f64, y: f64) {
         self.call(
             "Input.dispatchMouseEvent",
-            json!({ "type": "mouseWheel", "x": x, "y": y, "deltaX": 0, "deltaY": delta }),
+            json!({ "type": "mouseWheel", "x": x, "y": y, "deltaX": 0, "deltaY": -120 }),
         );
     }
 
-    /// Presses and releases a key: `Tab`, `Home`, `End`, an arrow or a letter.
+    /// Presses and releases a key: `Home`, `End`, `ArrowLeft`, `ArrowDown` or a letter (the
+    /// virtual key code is what moves a focused slider or menu).
     pub fn press(&mut self, key: &str) {
         let (code, virtual_key) = match key {
-            "Tab" => (key.to_owned(), 9),
             "End" => (key.to_owned(), 35),
             "Home" => (key.to_owned(), 36),
             "ArrowLeft" => (key.to_owned(), 37),
-            "ArrowUp" => (key.to_owned(), 38),
-            "ArrowRight" => (key.to_owned(), 39),
             "ArrowDown" => (key.to_owned(), 40),
             letter if letter.len() == 1 && letter.as_bytes()[0].is_ascii_alphabetic() => {
                 let upper = letter.to_ascii_uppercase();

@@ -250,7 +250,7 @@ fn the_inspector_zooms_reads_values_swipes_flips_and_follows_exposure_and_channe
     let stated = "document.querySelector('output.zoom').textContent";
     for _ in 0..5 {
         let before = browser.eval(stated);
-        browser.wheel(at.0, at.1, true);
+        browser.wheel_up(at.0, at.1);
         browser.wait_for("the wheel to zoom", &format!("{stated} !== {before}"));
     }
     let scale = view.fit * NOTCH.powi(5);
