@@ -4,7 +4,8 @@
 //! read back, the HTML report opened in headless Chromium, the golden cache, the command line and
 //! the shipped course rubric.
 
-// Shared with tests/diagnose.rs and tests/review.rs; the served page's functions are review's.
+// Shared with tests/diagnose.rs and tests/review.rs, whose DevTools driver starts Chromium
+// with its flags.
 #[allow(dead_code)]
 #[path = "grade/chromium.rs"]
 mod chromium;

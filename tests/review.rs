@@ -2,9 +2,10 @@
 //! its golden, the case's light made 3% brighter. The golden check runs as the suite runs it
 //! (insta's binary snapshot under the tolerance comparator, with insta's own file handling) in a
 //! child process of this test binary, where `INSTA_UPDATE` can be set; it fails and leaves
-//! insta's pending snapshot. Then the page is opened in headless Chromium, decisions are posted
-//! as its buttons post them, and the files are compared byte for byte with what insta's own
-//! accept code writes from the same pending snapshot.
+//! insta's pending snapshot. Then the page is opened in headless Chromium and driven over the
+//! DevTools protocol: a real click on Accept or Reject (`clicks`), the inspector's controls used
+//! with the mouse and keyboard (`controls`); the files are compared byte for byte with what
+//! insta's own accept code writes from the same pending snapshot.
 
 // Shared with tests/grade.rs and tests/diagnose.rs.
 #[allow(dead_code)]
@@ -17,22 +18,32 @@ mod chromium;
 mod comparator;
 mod util;
 
+// This test's own parts, under tests/review/ (a file right under tests/ would be a test of its own).
+#[path = "review/cdp.rs"]
+mod cdp;
+#[path = "review/clicks.rs"]
+mod clicks;
+#[path = "review/controls.rs"]
+mod controls;
+#[path = "review/served.rs"]
+mod served;
+
 use std::collections::BTreeMap;
 use std::fs;
-use std::io::{BufRead, BufReader, Read, Write};
-use std::net::TcpStream;
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
-use std::time::Duration;
+use std::process::{Command, Output};
 
 use goldray::case::{LoadOptions, load};
 use goldray::film::encode_exr;
 use goldray::pipeline::{provenance, render_case};
 
 use comparator::ToleranceComparator;
+use served::Served;
 use util::{goldray, shipped, stderr};
 
 const CASE: &str = "spheres_shadows";
+/// The page is ready once its load handler has counted what loaded and drawn the cases.
+const READY: &str = "document.body.hasAttribute('data-cases-loaded')";
 const PROJECT_VAR: &str = "GOLDRAY_REVIEW_PROJECT";
 
 /// What the comparator's messages call a path.
@@ -197,142 +208,6 @@ fn assert_accepted_as_insta_would(root: &Path, before: &BTreeMap<String, Vec<u8>
 
 /// A method, a path and headers.
 type Request = (&'static str, String, Vec<(&'static str, String)>);
-
-/// A `goldray review` server, stopped when dropped.
-struct Served {
-    child: Child,
-    url: String,
-    /// The server's stdout, kept open: it reports each decision there.
-    _stdout: BufReader<std::process::ChildStdout>,
-}
-
-impl Served {
-    fn start(root: &Path) -> Served {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_goldray"))
-            .args(["review", "--project"])
-            .arg(root)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::null())
-            .spawn()
-            .expect("goldray review starts");
-        let mut line = String::new();
-        let mut stdout = BufReader::new(child.stdout.take().unwrap());
-        stdout.read_line(&mut line).unwrap();
-        let url = line
-            .split_whitespace()
-            .find(|word| word.starts_with("http://127.0.0.1:"))
-            .unwrap_or_else(|| panic!("no address in `{line}`"))
-            .to_owned();
-        Served {
-            child,
-            url,
-            _stdout: stdout,
-        }
-    }
-
-    fn port(&self) -> u16 {
-        self.url
-            .trim_end_matches('/')
-            .rsplit(':')
-            .next()
-            .unwrap()
-            .parse()
-            .unwrap()
-    }
-
-    /// Sends one request with `headers` (Host is always sent) and returns the status and body.
-    fn request(&self, method: &str, path: &str, headers: &[(&str, String)]) -> (u16, String) {
-        let mut stream = TcpStream::connect(("127.0.0.1", self.port())).unwrap();
-        stream.set_read_timeout(Some(Duration::from_secs(60))).unwrap();
-        let mut text = format!("{method} {path} HTTP/1.1\r\nConnection: close\r\nContent-Length: 0\r\n");
-        if !headers.iter().any(|(name, _)| *name == "Host") {
-            text += &format!("Host: 127.0.0.1:{}\r\n", self.port());
-        }
-        for (name, value) in headers {
-            text += &format!("{name}: {value}\r\n");
-        }
-        stream.write_all(format!("{text}\r\n").as_bytes()).unwrap();
-        let mut bytes = Vec::new();
-        stream.read_to_end(&mut bytes).unwrap();
-        let answer = String::from_utf8_lossy(&bytes);
-        let status = answer
-            .split_whitespace()
-            .nth(1)
-            .and_then(|s| s.parse().ok())
-            .unwrap_or(0);
-        let body = answer
-            .split_once("\r\n\r\n")
-            .map(|(_, body)| body.to_owned())
-            .unwrap_or_default();
-        (status, body)
-    }
-
-    /// A POST as the page's buttons send it: same origin.
-    fn post(&self, path: &str) -> (u16, String) {
-        let origin = self.url.trim_end_matches('/').to_owned();
-        self.request("POST", path, &[("Origin", origin)])
-    }
-}
-
-impl Drop for Served {
-    fn drop(&mut self) {
-        let _ = self.child.kill();
-        let _ = self.child.wait();
-    }
-}
-
-#[test]
-fn the_page_lists_the_changed_case_and_its_accept_writes_what_insta_accept_writes() {
-    let project = changed_project();
-    let root = project.path();
-    fail_golden_check(root);
-    let insta = insta_accepted(root);
-    let before = files(root);
-    let served = Served::start(root);
-
-    let dom = chromium::dump_dom_url(&served.url, 1280, 1000);
-    for expected in [
-        format!("id=\"case-{CASE}\""),
-        "data-cases-loaded=\"1\"".to_owned(),
-        // The golden, the new render and the heatmap, each loaded; the first two also drawn
-        // from their linear values.
-        "data-images-loaded=\"3\"".to_owned(),
-        "data-images-broken=\"0\"".to_owned(),
-        "data-panes-drawn=\"2\"".to_owned(),
-        "<span class=\"badge\">FAIL</span>".to_owned(),
-        "broke fail_fraction".to_owned(),
-        format!("data-action=\"accept\" data-case=\"{CASE}\""),
-        "made differently</b> golden: case hash".to_owned(),
-    ] {
-        assert!(dom.contains(&expected), "the page lacks `{expected}`:\n{dom}");
-    }
-    assert_eq!(files(root), before, "opening the page writes nothing");
-
-    let (status, body) = served.post(&format!("/accept/{CASE}"));
-    assert_eq!(status, 200, "{body}");
-    assert!(body.contains("\"accepted\":true"), "{body}");
-    drop(served);
-    assert_accepted_as_insta_would(root, &before, &insta);
-}
-
-#[test]
-fn rejecting_on_the_page_keeps_the_golden_and_removes_the_pending_files() {
-    let project = changed_project();
-    let root = project.path();
-    let golden = files(root);
-    fail_golden_check(root);
-    let served = Served::start(root);
-    let (status, body) = served.post(&format!("/reject/{CASE}"));
-    assert_eq!(status, 200, "{body}");
-    assert!(pending_files(root).is_empty());
-    assert_eq!(files(root), golden, "the golden and the case as they were");
-    let (status, page) = served.request("GET", "/", &[]);
-    assert_eq!(status, 200);
-    assert!(
-        page.contains("0 pending goldens") && !page.contains("<button"),
-        "{page}"
-    );
-}
 
 /// A project whose pending snapshot is a copy of the golden, with the header insta writes.
 fn project_with_copied_pending() -> tempfile::TempDir {

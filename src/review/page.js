@@ -156,7 +156,7 @@ function draw(c) {
 
 function setupInspector(c) {
   var canvas = c.section.querySelector('canvas.view'), swipe = c.section.querySelector('input.swipe');
-  c.view = { canvas: canvas, swipe: swipe, scale: 0, ox: 0, oy: 0, drag: null };
+  c.view = { canvas: canvas, swipe: swipe, zoom: c.section.querySelector('output.zoom'), scale: 0, ox: 0, oy: 0, drag: null };
   var at = function (e) {
     var r = canvas.getBoundingClientRect(), k = canvas.width / r.width;
     return [(e.clientX - r.left) * k, (e.clientY - r.top) * k];
@@ -201,7 +201,9 @@ function drawView(c) {
   var put = function (src) {
     if (src) { ctx.drawImage(src, v.ox, v.oy, m.width * v.scale, m.height * v.scale); }
   };
+  var shown = [];
   var label = function (text, x, align) {
+    shown.push(text);
     ctx.font = (12 * ratio) + 'px system-ui,sans-serif'; ctx.textAlign = align;
     ctx.fillStyle = 'rgba(0,0,0,.6)';
     var w = ctx.measureText(text).width + 8 * ratio;
@@ -223,6 +225,9 @@ function drawView(c) {
     ctx.strokeStyle = '#ffeb3b'; ctx.lineWidth = ratio;
     ctx.strokeRect(v.ox + c.hover[0] * v.scale, v.oy + c.hover[1] * v.scale, v.scale, v.scale);
   }
+  // The labels drawn on the picture, for a screen reader; the zoom as screen pixels per image pixel.
+  canvas.setAttribute('aria-label', shown.join(' | '));
+  v.zoom.textContent = 'zoom ' + Number((v.scale / ratio).toPrecision(3)) + '×';
 }
 
 function fmt(v, linear) {

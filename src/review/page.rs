@@ -151,9 +151,10 @@ fn section(body: &mut String, case: &CaseParts, decisions: bool) {
         figure("diff", heatmap.as_deref(), heatmap_caption(review)),
     );
     body.push_str(
-        "<div class=\"inspector\"><div class=\"view-wrap\"><canvas class=\"view\"></canvas>\
+        "<div class=\"inspector\"><div class=\"view-wrap\"><canvas class=\"view\" role=\"img\"></canvas>\
          <input type=\"range\" class=\"swipe\" min=\"0\" max=\"1\" step=\"0.001\" value=\"0.5\" aria-label=\"swipe\"></div>\
-         <div class=\"side\"><p class=\"hint\">wheel: zoom · drag: pan · double-click: fit · F: flip</p>\
+         <div class=\"side\"><p class=\"hint\"><output class=\"zoom\"></output> · wheel: zoom · drag: pan · \
+         double-click: fit · F: flip</p>\
          <table class=\"readout\"></table></div></div>\n",
     );
     if let Some(comparison) = &review.comparison {

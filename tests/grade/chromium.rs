@@ -1,6 +1,6 @@
-//! Opening the HTML report in Debian's headless Chromium, from the file system (or the review
-//! page from its local server), with every network feature off: what a TA's browser sees,
-//! without a display.
+//! Opening the HTML report in Debian's headless Chromium, from the file system, with every
+//! network feature off: what a TA's browser sees, without a display. (tests/review/cdp.rs drives
+//! the same browser, with the same flags, through a page's clicks and keys.)
 
 use std::io::Read;
 use std::path::{Path, PathBuf};
@@ -11,39 +11,39 @@ const CHROMIUM: &str = "/usr/bin/chromium";
 /// Long enough for a cold start on a loaded CI machine, short enough that a hang fails the test.
 const TIMEOUT: Duration = Duration::from_secs(90);
 
-fn chromium() -> PathBuf {
+/// Debian's Chromium; panics saying how to install it where it is missing.
+pub fn chromium() -> PathBuf {
     let path = PathBuf::from(CHROMIUM);
     assert!(
         path.exists(),
-        "{CHROMIUM} is missing: the HTML report test needs Debian's chromium \
+        "{CHROMIUM} is missing: the tests that open pages need Debian's chromium \
          (`apt-get install -y chromium`; .ci/run installs it)"
     );
     path
 }
 
+/// The flags of every run here: headless, no GPU, no network feature, no first-run work.
+pub const FLAGS: [&str; 9] = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--hide-scrollbars",
+];
+
 /// Runs Chromium headless on `page` with `extra` arguments and returns its standard output.
 fn run(page: &Path, extra: &[String]) -> Vec<u8> {
-    run_url(&format!("file://{}", page.canonicalize().unwrap().display()), extra)
-}
-
-/// [`run`] on any address (a page served on 127.0.0.1).
-fn run_url(url: &str, extra: &[String]) -> Vec<u8> {
+    let url = format!("file://{}", page.canonicalize().unwrap().display());
     let profile = tempfile::tempdir().unwrap();
     let mut child = Command::new(chromium())
-        .args([
-            "--headless",
-            "--no-sandbox",
-            "--disable-gpu",
-            "--disable-quic",
-            "--no-first-run",
-            "--disable-background-networking",
-            "--disable-component-update",
-            "--disable-sync",
-            "--hide-scrollbars",
-        ])
+        .args(FLAGS)
         .arg(format!("--user-data-dir={}", profile.path().display()))
         .args(extra)
-        .arg(url)
+        .arg(&url)
         .stdout(Stdio::piped())
         .stderr(Stdio::null())
         .spawn()
@@ -103,17 +103,4 @@ pub fn screenshot(page: &Path, width: u32, height: u32, file: &Path) -> goldray:
         ],
     );
     goldray::rgb_image::read_png(file).unwrap_or_else(|e| panic!("{e}"))
-}
-
-/// [`dump_dom_at`] of a page served at `url`.
-pub fn dump_dom_url(url: &str, width: u32, height: u32) -> String {
-    let stdout = run_url(
-        url,
-        &[
-            "--virtual-time-budget=5000".to_owned(),
-            format!("--window-size={width},{height}"),
-            "--dump-dom".to_owned(),
-        ],
-    );
-    String::from_utf8(stdout).expect("the DOM is UTF-8")
 }
