@@ -10,11 +10,7 @@ use serde::{Deserialize, Serialize};
 use super::error::CompareError;
 use super::flip::Reference;
 use crate::film::{Film, Tonemap, color_image, decode_exr};
-use crate::rgb_image::{RgbImage, decode_png};
-
-/// The most memory a decoded PNG may take: 512 MiB, the limit the `image` crate set by default
-/// when it decoded these files, far above any picture goldray compares.
-const MAX_DECODED_BYTES: u64 = 512 << 20;
+use crate::rgb_image::{DEFAULT_MAX_BYTES, RgbImage, decode_png};
 
 /// The EXR channels goldray writes and reads, in the contract's order. Other channels in a file
 /// are not compared, because the film reader does not decode them.
@@ -128,7 +124,7 @@ impl Image {
 
     pub fn from_png_bytes(bytes: &[u8], source: impl Into<PathBuf>) -> Result<Image, CompareError> {
         let source = source.into();
-        let decoded = decode_png(bytes, MAX_DECODED_BYTES).map_err(|e| CompareError::Png {
+        let decoded = decode_png(bytes, DEFAULT_MAX_BYTES).map_err(|e| CompareError::Png {
             path: source.clone(),
             source: e,
         })?;

@@ -109,6 +109,11 @@ pub fn read_png(path: &Path) -> Result<RgbImage, DecodeError> {
     Ok(decode_png(&bytes, u64::MAX)?.image)
 }
 
+/// The decoding limit for files goldray reads on its own behalf (golden and compared pictures,
+/// cube map faces): 512 MiB decoded, the limit the `image` crate set by default when it decoded
+/// them, far above any picture goldray makes or compares. Students' files get the grader's own.
+pub const DEFAULT_MAX_BYTES: u64 = 512 << 20;
+
 /// Decodes `bytes` as a PNG of at most `max_bytes` once decoded (checked from the header, before
 /// anything is allocated: a decompression bomb declares its size).
 pub fn decode_png(bytes: &[u8], max_bytes: u64) -> Result<DecodedPng, DecodeError> {
@@ -130,7 +135,7 @@ pub fn decode_png(bytes: &[u8], max_bytes: u64) -> Result<DecodedPng, DecodeErro
     }
     let mut samples = vec![0; decoded_bytes as usize];
     reader.next_frame(&mut samples).map_err(failure)?;
-    let (image, translucent) = to_rgb8(width, height, layout, &samples);
+    let (image, translucent) = to_rgb8(width, height, layout, samples);
     Ok(DecodedPng {
         image,
         layout,
@@ -151,13 +156,13 @@ fn layout_of((color, depth): (png::ColorType, png::BitDepth)) -> PngLayout {
 }
 
 /// The samples as RGB bytes, and how many pixels are not opaque.
-fn to_rgb8(width: u32, height: u32, layout: PngLayout, samples: &[u8]) -> (RgbImage, usize) {
+fn to_rgb8(width: u32, height: u32, layout: PngLayout, samples: Vec<u8>) -> (RgbImage, usize) {
     let eight_bit: Vec<u8> = match layout.bits {
         16 => samples
             .chunks_exact(2)
             .map(|pair| ((u32::from(u16::from_be_bytes([pair[0], pair[1]])) + 128) / 257) as u8)
             .collect(),
-        _ => samples.to_vec(),
+        _ => samples,
     };
     let count = layout.channels.count();
     let translucent = match layout.has_alpha() {

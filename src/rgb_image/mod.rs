@@ -13,7 +13,7 @@ use std::iter::FusedIterator;
 
 use bytemuck::{Pod, Zeroable};
 
-pub use decode::{Channels, DecodeError, DecodedPng, PngLayout, decode_png, read_png};
+pub use decode::{Channels, DEFAULT_MAX_BYTES, DecodeError, DecodedPng, PngLayout, decode_png, read_png};
 
 /// One pixel: red, green and blue.
 #[repr(transparent)]

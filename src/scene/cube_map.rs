@@ -9,7 +9,7 @@ use rayon::prelude::*;
 
 use super::real::{Color, Real, Vec3};
 pub use crate::build_error::CubeMapError;
-use crate::rgb_image::decode_png;
+use crate::rgb_image::{DEFAULT_MAX_BYTES, decode_png};
 use crate::simd::Isa;
 
 /// One face: a PNG read and checked at load, decoded when a ray first looks at it.
@@ -34,10 +34,6 @@ pub struct CubeMap {
     /// In the order of `FACE_NAMES`.
     faces: [Face; 6],
 }
-
-/// The most memory a face other than 8-bit RGB may take while it is converted: 512 MiB, the
-/// limit the `image` crate set by default when it converted faces.
-const MAX_FACE_BYTES: u64 = 512 << 20;
 
 const FACE_NAMES: [&str; 6] = ["right", "left", "up", "down", "front", "back"];
 const RIGHT: usize = 0;
@@ -225,7 +221,7 @@ fn decode_rgb8(png: &[u8]) -> Result<Vec<u8>, String> {
     decoder.ignore_checksums(true);
     let mut reader = decoder.read_info().map_err(|e| e.to_string())?;
     if reader.output_color_type() != (png::ColorType::Rgb, png::BitDepth::Eight) {
-        let decoded = decode_png(png, MAX_FACE_BYTES).map_err(|e| e.to_string())?;
+        let decoded = decode_png(png, DEFAULT_MAX_BYTES).map_err(|e| e.to_string())?;
         return Ok(decoded.image.into_raw());
     }
     let size = reader.output_buffer_size().ok_or("the image is too large")?;
