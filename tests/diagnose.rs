@@ -151,8 +151,10 @@ const PAIRS: [&str; 5] = [
 ];
 
 /// The course's starter code as shipped: flat colours, and no plane, triangle or transform
-/// intersection, no point light, no background (the point light cannot show under flat colours).
-const STARTER: &str = "nothing-shaded+plane-missing+triangle-missing+transform-missing+background-missing";
+/// intersection, no point light, no background (the point light cannot show under flat colours),
+/// and its render loop, which writes a miss's depth white.
+const STARTER: &str =
+    "nothing-shaded+plane-missing+triangle-missing+transform-missing+depth-miss-white+background-missing";
 
 struct Graded {
     dir: PathBuf,
@@ -485,7 +487,10 @@ fn an_independent_programs_mistakes_are_diagnosed_too() {
     let starter = student(graded, "starter");
     assert_eq!(
         starter.unfinished.as_ref().map(|u| u.summary.as_str()),
-        Some("unfinished: shading, planes, triangles, transforms and the background are not implemented"),
+        Some(
+            "unfinished: shading, planes, triangles, transforms, misses in the depth image and the background are \
+             not implemented"
+        ),
         "{:#?}",
         starter
             .images

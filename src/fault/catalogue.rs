@@ -205,7 +205,10 @@ impl Fault {
             NormalsNotRemapped => "main: write (n + 1)/2 per channel",
             DepthInverted => "main: grey = (t − min)/(max − min), near black",
             DepthNotClamped => "main: clamp (t − min)/(max − min) to [0, 1]",
-            DepthMissWhite => "main: a pixel with no hit is black in the depth image",
+            DepthMissWhite => {
+                "Renderer::Render: a pixel with no hit is black in the depth image (the starter's loop writes \
+                 (t − min)/(max − min) for every pixel, and a miss keeps t = FLT_MAX)"
+            }
             CubemapFaceFlipped => "CubeMap: the face's (u, v) and texel row order",
             CubemapIgnored => "RayTracer::traceRay: a miss returns the cube map's colour when the scene has one",
             PointLightMissing => {
@@ -245,8 +248,9 @@ impl Fault {
     }
 
     /// The part of the assignment a fault leaves unwritten, when the fault is the starter code's
-    /// `TODO` as shipped (or a feature of the command line never begun) rather than a mistake in
-    /// code that was written: a student with several of them is told once that the work is
+    /// `TODO` as shipped (or a feature of the command line never begun, or the starter's own render
+    /// loop left as it is: it writes a miss's `t = FLT_MAX` to the depth image, so misses are
+    /// white) rather than a mistake in code that was written: a student with several of them is told once that the work is
     /// unfinished, with the parts, instead of one mistake per part. `nothing-shaded` stands for
     /// all of the shading (lights, Phong, shadows, reflections), which a flat colour hides.
     pub const fn unfinished_part(self) -> Option<&'static str> {
@@ -261,6 +265,7 @@ impl Fault {
             TriangleMissing => "triangles",
             TransformMissing => "transforms",
             BackgroundMissing => "the background",
+            DepthMissWhite => "misses in the depth image",
             NoJitter => "jitter",
             NoFilter => "the filter",
             _ => return None,

@@ -23,7 +23,8 @@
 //! ([`signature`]): an independent program's speckles fall elsewhere and come at another
 //! density, but darken the same surfaces in scattered pixels; with another mistake they are
 //! compared over blocks. Fault sets of any size are grown for images nothing smaller explains
-//! ([`grow`]), and a set naming a mistake in written code must be clearly closer than any set of
+//! ([`grow`]) and, for unfinished work whose parts show only together, shrunk from every part
+//! not written ([`shrink`]); a set naming a mistake in written code must be clearly closer than any set of
 //! parts not written ([`decide`]).
 
 mod batch;
@@ -33,6 +34,7 @@ mod expand;
 mod grow;
 mod pictures;
 mod residual;
+mod shrink;
 mod signature;
 mod student;
 

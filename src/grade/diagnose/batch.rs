@@ -16,7 +16,7 @@ use super::super::score::StudentResult;
 use super::super::submission::read_png;
 use super::{
     Candidate, Diagnosis, DiagnosisRun, RenderDiagnosis, Scored, Subject, UNEXPLAINED, candidates, decide, expansions,
-    fit_background, fit_gamma, grow, loses_points, pictures, residual, student_dir,
+    fit_background, fit_gamma, grow, loses_points, pictures, residual, shrink, student_dir,
 };
 use crate::fault::FaultSet;
 use crate::film::Picture;
@@ -226,7 +226,8 @@ impl<'a> Diagnoser<'a> {
             // Several faults at once, for the images nothing above explains.
             let known: Vec<&Candidate> = singles.iter().chain(&expanded).collect();
             let grown = grow::grow(&subjects, &mut scored, &known, &singles, &get);
-            let fault_sets = fault_sets + grown.len();
+            let shrunk = shrink::shrink(&subjects, &mut scored, &singles, &get);
+            let fault_sets = fault_sets + grown.len() + shrunk.len();
             let decided: Vec<Option<(Diagnosis, usize, usize)>> = failing
                 .par_iter()
                 .zip(subjects.par_iter().zip(scored.par_iter().zip(asked.par_iter())))

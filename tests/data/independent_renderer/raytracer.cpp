@@ -18,8 +18,10 @@
 //   shading                      the starter's traceRay: the flat diffuse colour
 //   specular, shadows, reflections   that part never written
 //   acne                         shadow rays start on the surface with tmin = 0
+//   depth-miss                   the starter's render loop: (t - min)/(max - min) written for
+//                                every pixel, so a miss (t = FLT_MAX) is white in the depth image
 //   starter                      the starter as shipped: plane, triangle, transform, point-light,
-//                                background and shading at once
+//                                background, shading and depth-miss at once
 //
 // Built by the tests with:  c++ -O2 -o raytracer raytracer.cpp
 #include <cmath>
@@ -484,7 +486,7 @@ int main(int argc, char** argv) {
         std::stringstream items(list);
         for (std::string item; std::getline(items, item, ',');) {
             if (item == "starter")
-                for (const char* part : {"plane", "triangle", "transform", "point-light", "background", "shading"})
+                for (const char* part : {"plane", "triangle", "transform", "point-light", "background", "shading", "depth-miss"})
                     planted.insert(part);
             else if (!item.empty()) planted.insert(item);
         }
@@ -507,7 +509,7 @@ int main(int argc, char** argv) {
             V c = tracer.trace(scene.center, d, 0, bounces, hit);
             bool missed = hit.material < 0;
             V n = missed ? V{} : hit.normal;
-            float z = missed ? 0 : (hit.t - depth_min) / (depth_max - depth_min);
+            float z = missed && !plants("depth-miss") ? 0 : (hit.t - depth_min) / (depth_max - depth_min);
             size_t at = (size_t(h - 1 - y) * w + x) * 3;  // row 0 of the file is the top
             float channels[3][3] = {{c.x, c.y, c.z}, {(n.x + 1) / 2, (n.y + 1) / 2, (n.z + 1) / 2}, {z, z, z}};
             for (int k = 0; k < 3; k++) {
