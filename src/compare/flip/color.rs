@@ -48,6 +48,29 @@ pub(super) fn perceived(ycxcz: [f32; 3]) -> [f32; 3] {
     hunt_lab([r.clamp(0.0, 1.0), g.clamp(0.0, 1.0), b.clamp(0.0, 1.0)])
 }
 
+/// [`perceived`], remembering the last colour it was given: a render's flat regions (a
+/// background, an unlit floor) filter to the same colour pixel after pixel, and the previous
+/// result is reused when the colour is the same to the bit, which is exact and skips three cube
+/// roots.
+#[derive(Default)]
+pub(super) struct Perceiver {
+    last: Option<([u32; 3], [f32; 3])>,
+}
+
+impl Perceiver {
+    pub(super) fn perceived(&mut self, ycxcz: [f32; 3]) -> [f32; 3] {
+        let bits = ycxcz.map(f32::to_bits);
+        match self.last {
+            Some((seen, result)) if seen == bits => result,
+            _ => {
+                let result = perceived(ycxcz);
+                self.last = Some((bits, result));
+                result
+            }
+        }
+    }
+}
+
 /// A linear RGB colour in CIELAB with the Hunt adjustment.
 fn hunt_lab(rgb: [f32; 3]) -> [f32; 3] {
     hunt(xyz_to_lab(linear_rgb_to_xyz(rgb)))

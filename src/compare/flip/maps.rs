@@ -7,7 +7,7 @@ use std::ops::Range;
 
 use crate::rgb_image::RgbImage;
 
-use super::color::{color_error, feature_input, flip_error, perceived, srgb_to_ycxcz, strengths};
+use super::color::{Perceiver, color_error, feature_input, flip_error, srgb_to_ycxcz, strengths};
 use super::kernels::KERNELS;
 
 /// What FLIP's per-pixel error reads of one picture, over a band of its rows.
@@ -26,7 +26,7 @@ pub(super) struct Maps {
 #[derive(Clone)]
 pub(in crate::compare) struct Reference {
     pub(super) maps: Maps,
-    /// Each pixel's filtered colour as FLIP compares colours ([`perceived`]).
+    /// Each pixel's filtered colour as FLIP compares colours ([`super::color::perceived`]).
     pub(super) perceived: Vec<[f32; 3]>,
     /// Each pixel's edge and point [`strengths`].
     pub(super) strengths: Vec<[f32; 2]>,
@@ -42,17 +42,19 @@ impl Reference {
     pub(super) fn of(picture: &RgbImage) -> Reference {
         let maps = Maps::of(picture, 0..picture.height() as usize);
         let pixels = maps.color[0].len();
+        let mut perceiver = Perceiver::default();
+        let perceived = (0..pixels).map(|p| perceiver.perceived(maps.color(p))).collect();
         Reference {
-            perceived: (0..pixels).map(|p| perceived(maps.color(p))).collect(),
+            perceived,
             strengths: (0..pixels).map(|p| strengths(maps.features(p))).collect(),
             maps,
         }
     }
 
     /// FLIP's error at `pixel` of a picture whose filtered colour and feature responses there are
-    /// `color` and `features`.
-    pub(super) fn error(&self, pixel: usize, color: [f32; 3], features: [f32; 4]) -> f32 {
-        let color_error = color_error(self.perceived[pixel], perceived(color));
+    /// `color` and `features` (the colour perceived through `perceiver`).
+    pub(super) fn error(&self, pixel: usize, color: [f32; 3], features: [f32; 4], perceiver: &mut Perceiver) -> f32 {
+        let color_error = color_error(self.perceived[pixel], perceiver.perceived(color));
         flip_error(color_error, self.strengths[pixel], strengths(features))
     }
 }

@@ -71,13 +71,14 @@ pub(super) fn flip_mean(expected: &RgbImage, reference: &OnceLock<Reference>, ac
 /// The sum of FLIP's error map of a test picture whose maps are `test` (over the rows where it
 /// differs) against `reference`. Pixels whose maps agree exactly have no error.
 fn dense_error_sum(reference: &Reference, test: &Maps) -> f64 {
+    let mut perceiver = color::Perceiver::default();
     test.pixels()
         .map(|p| {
             let (color, features) = (test.color(p), test.features(p));
             if color == reference.maps.color(p) && features == reference.maps.features(p) {
                 return 0.0;
             }
-            f64::from(reference.error(p, color, features))
+            f64::from(reference.error(p, color, features, &mut perceiver))
         })
         .sum()
 }

@@ -5,7 +5,7 @@
 
 use crate::rgb_image::RgbImage;
 
-use super::color::{feature_input, srgb_to_ycxcz};
+use super::color::{Perceiver, feature_input, srgb_to_ycxcz};
 use super::kernels::{KERNELS, clamped_weight};
 use super::maps::Reference;
 
@@ -56,6 +56,7 @@ pub(super) fn error_sum(picture: &RgbImage, reference: &Reference, test: &RgbIma
             }
         }
     }
+    let mut perceiver = Perceiver::default();
     changes
         .reached
         .iter()
@@ -64,7 +65,7 @@ pub(super) fn error_sum(picture: &RgbImage, reference: &Reference, test: &RgbIma
             let (color, features) = (reference.maps.color(p), reference.maps.features(p));
             let color = [0, 1, 2].map(|c| color[c] + change[c]);
             let features = [0, 1, 2, 3].map(|c| features[c] + change[3 + c]);
-            f64::from(reference.error(p, color, features))
+            f64::from(reference.error(p, color, features, &mut perceiver))
         })
         .sum()
 }

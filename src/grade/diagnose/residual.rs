@@ -71,19 +71,36 @@ pub fn block_residual(expected: &RgbImage, actual: &RgbImage, threshold: f64, bl
     }
 }
 
+/// Each block's mean per channel. Sums are kept in integers row by row (exact, as the f64 sums
+/// of the codes were: far below 2⁵³), so the means are the same to the bit.
 fn block_means(picture: &RgbImage, block: u32) -> Vec<[f64; 3]> {
     let (w, h) = picture.dimensions();
-    let (bw, bh) = (w.div_ceil(block), h.div_ceil(block));
-    let mut sums = vec![([0.0f64; 3], 0u32); (bw * bh) as usize];
-    for (x, y, p) in picture.enumerate_pixels() {
-        let cell = &mut sums[((y / block) * bw + x / block) as usize];
-        for c in 0..3 {
-            cell.0[c] += f64::from(p.0[c]);
+    let (bw, bh) = (w.div_ceil(block) as usize, h.div_ceil(block) as usize);
+    let mut sums = vec![[0u64; 3]; bw * bh];
+    let row_bytes = 3 * w as usize;
+    for (y, row) in picture.as_raw().chunks_exact(row_bytes.max(1)).enumerate() {
+        let cells = &mut sums[(y / block as usize) * bw..][..bw];
+        for (cell, pixels) in cells.iter_mut().zip(row.chunks(3 * block as usize)) {
+            let mut run = [0u32; 3];
+            for pixel in pixels.chunks_exact(3) {
+                for c in 0..3 {
+                    run[c] += u32::from(pixel[c]);
+                }
+            }
+            for c in 0..3 {
+                cell[c] += u64::from(run[c]);
+            }
         }
-        cell.1 += 1;
     }
+    let counts = |i: usize| {
+        let (bx, by) = ((i % bw) as u32, (i / bw) as u32);
+        let across = block.min(w - bx * block);
+        let down = block.min(h - by * block);
+        f64::from(across * down)
+    };
     sums.into_iter()
-        .map(|(s, n)| s.map(|v| v / f64::from(n.max(1))))
+        .enumerate()
+        .map(|(i, s)| s.map(|v| v as f64 / counts(i).max(1.0)))
         .collect()
 }
 
@@ -108,6 +125,24 @@ mod tests {
         Residual {
             failing_fraction: failing as f64 / pixels as f64,
             rmse: (sum_sq as f64 / (3 * pixels) as f64).sqrt(),
+        }
+    }
+
+    #[test]
+    fn block_means_are_the_plain_means() {
+        let picture = RgbImage::from_fn(37, 11, |x, y| Rgb([(x * 7 + y) as u8, (x * y) as u8, 255 - x as u8]));
+        for block in [4, 5, 16, 64] {
+            let (bw, bh) = (37u32.div_ceil(block), 11u32.div_ceil(block));
+            let mut plain = vec![([0.0f64; 3], 0u32); (bw * bh) as usize];
+            for (x, y, p) in picture.enumerate_pixels() {
+                let cell = &mut plain[((y / block) * bw + x / block) as usize];
+                for c in 0..3 {
+                    cell.0[c] += f64::from(p.0[c]);
+                }
+                cell.1 += 1;
+            }
+            let plain: Vec<[f64; 3]> = plain.into_iter().map(|(s, n)| s.map(|v| v / f64::from(n))).collect();
+            assert_eq!(block_means(&picture, block), plain, "{block}");
         }
     }
 
