@@ -207,7 +207,8 @@ impl Fault {
             DepthNotClamped => "main: clamp (t − min)/(max − min) to [0, 1]",
             DepthMissWhite => {
                 "Renderer::Render: a pixel with no hit is black in the depth image (the starter's loop writes \
-                 (t − min)/(max − min) for every pixel, and a miss keeps t = FLT_MAX)"
+                 (t − min)/(max − min) for a miss too, from t = FLT_MAX: its conversion to a code overflows, \
+                 which x86 writes as 0 and ARM as 255)"
             }
             CubemapFaceFlipped => "CubeMap: the face's (u, v) and texel row order",
             CubemapIgnored => "RayTracer::traceRay: a miss returns the cube map's colour when the scene has one",
@@ -249,8 +250,9 @@ impl Fault {
 
     /// The part of the assignment a fault leaves unwritten, when the fault is the starter code's
     /// `TODO` as shipped (or a feature of the command line never begun, or the starter's own render
-    /// loop left as it is: it writes a miss's `t = FLT_MAX` to the depth image, so misses are
-    /// white) rather than a mistake in code that was written: a student with several of them is told once that the work is
+    /// loop left as it is: it never handles a miss in the depth image, whose `t = FLT_MAX` overflows
+    /// the conversion to a code, black on x86 by luck and white on ARM) rather than a mistake in
+    /// code that was written: a student with several of them is told once that the work is
     /// unfinished, with the parts, instead of one mistake per part. `nothing-shaded` stands for
     /// all of the shading (lights, Phong, shadows, reflections), which a flat colour hides.
     pub const fn unfinished_part(self) -> Option<&'static str> {

@@ -18,10 +18,12 @@
 //   shading                      the starter's traceRay: the flat diffuse colour
 //   specular, shadows, reflections   that part never written
 //   acne                         shadow rays start on the surface with tmin = 0
-//   depth-miss                   the starter's render loop: (t - min)/(max - min) written for
-//                                every pixel, so a miss (t = FLT_MAX) is white in the depth image
-//   starter                      the starter as shipped: plane, triangle, transform, point-light,
-//                                background, shading and depth-miss at once
+//   depth-miss                   a miss is white in the depth image: the starter's render loop
+//                                writes (t - min)/(max - min) for a miss too (t = FLT_MAX), whose
+//                                conversion to a code overflows; ARM saturates it to 255
+//   starter                      the starter as shipped, as it runs on x86 (where that overflow
+//                                writes 0, black as the course's): plane, triangle, transform,
+//                                point-light, background and shading at once
 //
 // Built by the tests with:  c++ -O2 -o raytracer raytracer.cpp
 #include <cmath>
@@ -486,7 +488,7 @@ int main(int argc, char** argv) {
         std::stringstream items(list);
         for (std::string item; std::getline(items, item, ',');) {
             if (item == "starter")
-                for (const char* part : {"plane", "triangle", "transform", "point-light", "background", "shading", "depth-miss"})
+                for (const char* part : {"plane", "triangle", "transform", "point-light", "background", "shading"})
                     planted.insert(part);
             else if (!item.empty()) planted.insert(item);
         }
