@@ -64,6 +64,29 @@ pub fn replace_file(path: &Path, bytes: &[u8]) -> Result<(), AtomicWriteError> {
     written.map_err(error)
 }
 
+/// Makes `link` a hard link to the file `original` (same filesystem), replacing whatever `link`
+/// was atomically: readers see the old file or the new link, never neither. For content-addressed
+/// caches, where many names stand for one file.
+pub fn link_file(original: &Path, link: &Path) -> Result<(), AtomicWriteError> {
+    let error = |source| AtomicWriteError::Write {
+        path: link.to_path_buf(),
+        source,
+    };
+    static NEXT: AtomicU64 = AtomicU64::new(0);
+    let dir = parent_folder(link);
+    fs::create_dir_all(dir).map_err(error)?;
+    let temp = dir.join(format!(
+        ".goldray-{}-{}.link",
+        std::process::id(),
+        NEXT.fetch_add(1, Ordering::Relaxed)
+    ));
+    let linked = fs::hard_link(original, &temp).and_then(|()| fs::rename(&temp, link));
+    if linked.is_err() {
+        let _ = fs::remove_file(&temp);
+    }
+    linked.map_err(error)
+}
+
 /// Checks, before any work is spent on it, that `path` could be written: it is not a folder, and
 /// its folder (or, when that is missing, the nearest existing folder above it, since writing
 /// creates missing folders) accepts a new file. The error names `path`, never a temporary file.

@@ -4,6 +4,13 @@
 //! `SET` the fault set as written (`no-shadows+gamma-applied=2.2`) and `PICTURE` `color`,
 //! `normals` or `depth-MIN-MAX`. A set whose faults all act on the PNGs is quantised from the
 //! golden film and never rendered nor stored.
+//!
+//! Most mistakes change one picture of a render and leave the others as the golden draws them
+//! (of the 94 fault sets of course scene 7, 79 draw the golden normals), so each distinct picture
+//! is stored once, as `KEY/by-content/HASH.png` (BLAKE3 of its size and codes), and every set's
+//! file is a hard link to it: a picture is decoded once per run however many sets draw it (the
+//! reader knows a link by its file's identity), where decoding was most of a warm diagnosis.
+//! Where links cannot be made, each set keeps its own copy, as before.
 
 use std::collections::HashMap;
 use std::fs;
@@ -12,7 +19,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
 use super::super::golden::CacheMode;
-use crate::atomic_write::write_file_atomic;
+use crate::atomic_write::{link_file, write_file_atomic};
 use crate::case::Case;
 use crate::fault::FaultSet;
 use crate::film::{Film, Picture, Tonemap, encode_png, picture_with_faults};
@@ -45,6 +52,8 @@ pub struct FaultPictures<'a> {
     /// set is rendered, so that a later grading finds whichever it needs.
     stored: Vec<Picture>,
     memo: Mutex<HashMap<String, Arc<Vec<RgbImage>>>>,
+    /// Cache files decoded in this run, by file identity: one picture stored for many sets.
+    decoded: Mutex<HashMap<FileIdentity, RgbImage>>,
     /// The last films rendered, by render part, so that a render fault paired with PNG faults
     /// is quantised again rather than rendered again.
     films: Mutex<Vec<(String, Arc<Film>)>>,
@@ -74,6 +83,7 @@ impl<'a> FaultPictures<'a> {
             pictures,
             stored,
             memo: Mutex::new(HashMap::new()),
+            decoded: Mutex::new(HashMap::new()),
             films: Mutex::new(Vec::new()),
             rendered: AtomicUsize::new(0),
             cached: AtomicUsize::new(0),
@@ -104,10 +114,27 @@ impl<'a> FaultPictures<'a> {
         }
         for picture in &self.stored {
             let image = picture_with_faults(film, *picture, self.tonemap, faults);
-            if let (Some(path), Ok(bytes)) = (self.entry(label, *picture), encode_png(&image)) {
+            let (Some(path), Some(content)) = (self.entry(label, *picture), self.content_entry(&image)) else {
+                continue;
+            };
+            let stored =
+                content.exists() || encode_png(&image).is_ok_and(|bytes| write_file_atomic(&content, &bytes).is_ok());
+            if !(stored && link_file(&content, &path).is_ok())
+                && let Ok(bytes) = encode_png(&image)
+            {
                 let _ = write_file_atomic(&path, &bytes);
             }
         }
+    }
+
+    /// Where the picture's content is stored once for every set that draws it.
+    fn content_entry(&self, image: &RgbImage) -> Option<PathBuf> {
+        let mut hasher = blake3::Hasher::new();
+        hasher.update(&image.width().to_le_bytes());
+        hasher.update(&image.height().to_le_bytes());
+        hasher.update(image.as_raw());
+        let name = format!("{}.png", &hasher.finalize().to_hex()[..32]);
+        Some(self.dir.as_ref()?.join(CONTENT_DIR).join(name))
     }
 
     /// The pictures a program with `faults` writes, in the order of [`FaultPictures::pictures`]:
@@ -176,16 +203,53 @@ impl<'a> FaultPictures<'a> {
         )
     }
 
-    /// Every picture of the set, or nothing: a partial or damaged entry is rendered again.
+    /// Every picture of the set, or nothing: a partial or damaged entry is rendered again. A file
+    /// that this run already decoded under another set's name (a link to the same content) is
+    /// not decoded again.
     fn read_cache(&self, label: &str) -> Option<Vec<RgbImage>> {
         let (width, height) = (self.golden.width, self.golden.height);
         self.pictures
             .iter()
             .map(|p| {
-                let bytes = fs::read(self.entry(label, *p)?).ok()?;
+                let path = self.entry(label, *p)?;
+                let identity = file_identity(&path)?;
+                if let Some(known) = self.decoded_files().get(&identity) {
+                    return Some(known.clone());
+                }
+                let bytes = fs::read(&path).ok()?;
                 let picture = decode_png(&bytes, 3 * u64::from(width) * u64::from(height)).ok()?.image;
-                (picture.dimensions() == (width, height)).then_some(picture)
+                if picture.dimensions() != (width, height) {
+                    return None;
+                }
+                self.decoded_files().insert(identity, picture.clone());
+                Some(picture)
             })
             .collect()
     }
+
+    fn decoded_files(&self) -> std::sync::MutexGuard<'_, HashMap<FileIdentity, RgbImage>> {
+        self.decoded.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+}
+
+/// The folder of a render's cache that holds each distinct picture once.
+const CONTENT_DIR: &str = "by-content";
+
+/// What tells one file from another whatever its names: device and inode on Unix (hard links
+/// share them); elsewhere the path, so that only a file's own name finds it again.
+#[cfg(unix)]
+type FileIdentity = (u64, u64);
+#[cfg(not(unix))]
+type FileIdentity = PathBuf;
+
+#[cfg(unix)]
+fn file_identity(path: &std::path::Path) -> Option<FileIdentity> {
+    use std::os::unix::fs::MetadataExt;
+    let meta = fs::metadata(path).ok()?;
+    Some((meta.dev(), meta.ino()))
+}
+
+#[cfg(not(unix))]
+fn file_identity(path: &std::path::Path) -> Option<FileIdentity> {
+    fs::metadata(path).ok().map(|_| path.to_path_buf())
 }
