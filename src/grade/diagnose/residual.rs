@@ -8,36 +8,57 @@ use crate::rgb_image::RgbImage;
 
 /// Pixel by pixel. Both pictures have the same size (the caller checks). Diagnosis measures
 /// every candidate against every image that lost points (tens of 800×800 pictures an image), so
-/// this works on the raw bytes in runs of [`RUN`] pixels that the compiler vectorises: the
-/// squared differences summed in integers and each byte's verdict kept, then the verdicts of a
-/// pixel's three channels joined. A difference in codes is an integer, so it exceeds the
-/// threshold exactly when it exceeds the threshold's integer part.
+/// this works on the raw bytes in runs of [`RUN`] pixels that the compiler vectorises, with the
+/// machine's widest vectors ([`crate::simd::dispatch`]; the sums are integers, the same on every
+/// path): the squared differences summed in integers and each byte's verdict kept, then the
+/// verdicts of a pixel's three channels joined. A difference in codes is an integer, so it
+/// exceeds the threshold exactly when it exceeds the threshold's integer part.
 pub fn residual(expected: &RgbImage, actual: &RgbImage, threshold: f64) -> Residual {
     let limit = if threshold < 0.0 {
         -1
     } else {
         threshold.min(255.0) as i32
     };
-    let (expected_bytes, actual_bytes) = (expected.as_raw(), actual.as_raw());
-    let (mut failing, mut sum_sq) = (0usize, 0u64);
-    let mut over = [false; 3 * RUN];
-    for (e, a) in expected_bytes.chunks(3 * RUN).zip(actual_bytes.chunks(3 * RUN)) {
-        let mut run_sq = 0u32;
-        for ((x, y), over) in e.iter().zip(a).zip(over.iter_mut()) {
-            let d = u32::from(x.abs_diff(*y));
-            run_sq += d * d;
-            *over = d as i32 > limit;
-        }
-        sum_sq += u64::from(run_sq);
-        failing += over[..e.len()]
-            .chunks_exact(3)
-            .filter(|channels| channels[0] | channels[1] | channels[2])
-            .count();
-    }
+    let (failing, sum_sq) = crate::simd::dispatch(Runs {
+        expected: expected.as_raw(),
+        actual: actual.as_raw(),
+        limit,
+    });
     let pixels = (expected.width() as usize * expected.height() as usize).max(1);
     Residual {
         failing_fraction: failing as f64 / pixels as f64,
         rmse: (sum_sq as f64 / (3 * pixels) as f64).sqrt(),
+    }
+}
+
+/// [`residual`]'s loop over two pictures' bytes: the failing pixels and the sum of squares.
+struct Runs<'a> {
+    expected: &'a [u8],
+    actual: &'a [u8],
+    limit: i32,
+}
+
+impl crate::simd::Kernel for Runs<'_> {
+    type Output = (usize, u64);
+
+    #[inline(always)]
+    fn run<I: crate::simd::Isa>(self) -> (usize, u64) {
+        let (mut failing, mut sum_sq) = (0usize, 0u64);
+        let mut over = [false; 3 * RUN];
+        for (e, a) in self.expected.chunks(3 * RUN).zip(self.actual.chunks(3 * RUN)) {
+            let mut run_sq = 0u32;
+            for ((x, y), over) in e.iter().zip(a).zip(over.iter_mut()) {
+                let d = u32::from(x.abs_diff(*y));
+                run_sq += d * d;
+                *over = d as i32 > self.limit;
+            }
+            sum_sq += u64::from(run_sq);
+            failing += over[..e.len()]
+                .chunks_exact(3)
+                .filter(|channels| channels[0] | channels[1] | channels[2])
+                .count();
+        }
+        (failing, sum_sq)
     }
 }
 
