@@ -64,6 +64,28 @@ pub fn replace_file(path: &Path, bytes: &[u8]) -> Result<(), AtomicWriteError> {
     written.map_err(error)
 }
 
+/// Writes `path` with `bytes` only if no file is there yet, so that concurrent writers of the
+/// same content-addressed file leave one file, whoever came first: the bytes go to a synced
+/// temporary file beside `path`, which is then linked to `path` (a link never replaces).
+pub fn publish_file(path: &Path, bytes: &[u8]) -> Result<(), AtomicWriteError> {
+    static NEXT: AtomicU64 = AtomicU64::new(0);
+    let temp = parent_folder(path).join(format!(
+        ".goldray-{}-{}.new",
+        std::process::id(),
+        NEXT.fetch_add(1, Ordering::Relaxed)
+    ));
+    write_file_atomic(&temp, bytes)?;
+    let published = match fs::hard_link(&temp, path) {
+        Err(e) if e.kind() != io::ErrorKind::AlreadyExists => Err(AtomicWriteError::Write {
+            path: path.to_path_buf(),
+            source: e,
+        }),
+        _ => Ok(()),
+    };
+    let _ = fs::remove_file(&temp);
+    published
+}
+
 /// Makes `link` a hard link to the file `original` (same filesystem), replacing whatever `link`
 /// was atomically: readers see the old file or the new link, never neither. For content-addressed
 /// caches, where many names stand for one file.
@@ -303,6 +325,29 @@ mod tests {
             2,
             "the temporary file is removed"
         );
+    }
+
+    #[test]
+    fn a_published_file_keeps_the_first_content_and_links_share_it() {
+        #[cfg(unix)]
+        use std::os::unix::fs::MetadataExt;
+        let dir = tempfile::tempdir().expect("temp dir");
+        let content = dir.path().join("by-content/abc.png");
+        fs::create_dir_all(content.parent().unwrap()).expect("folder");
+        publish_file(&content, b"first").expect("publish");
+        publish_file(&content, b"second").expect("a second publisher is not an error");
+        assert_eq!(fs::read(&content).expect("read"), b"first");
+        let link = dir.path().join("set/color.png");
+        replace_file(&link, b"an older copy").expect("write");
+        link_file(&content, &link).expect("link");
+        assert_eq!(fs::read(&link).expect("read"), b"first");
+        #[cfg(unix)]
+        assert_eq!(
+            fs::metadata(&link).unwrap().ino(),
+            fs::metadata(&content).unwrap().ino()
+        );
+        let left = |folder: &str| fs::read_dir(dir.path().join(folder)).expect("list").count();
+        assert_eq!((left("by-content"), left("set")), (1, 1), "no temporary file is left");
     }
 
     #[test]

@@ -32,6 +32,7 @@ mod candidates;
 mod decide;
 mod expand;
 mod grow;
+mod mask;
 mod pictures;
 mod residual;
 mod shrink;

@@ -22,10 +22,11 @@
 //! A fault is therefore in a set only for pixels of the student's own image that it accounts for,
 //! and the search stops when what is left is noise.
 
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 
 use rayon::prelude::*;
 
+use super::mask::Mask;
 use super::*;
 
 /// The largest set grown.
@@ -60,6 +61,7 @@ pub(super) fn grow(
         .zip(scores.iter())
         .map(|(subject, scores)| start(subject.as_ref()?, scores))
         .collect();
+    let changes = single_changes(&searches, subjects, singles);
     let mut grown: Vec<Candidate> = Vec::new();
     for _ in 1..MAX_FAULTS {
         // What each image offers its beam, from the pictures alone.
@@ -67,7 +69,10 @@ pub(super) fn grow(
             .par_iter_mut()
             .zip(subjects.par_iter())
             .map(|(search, subject)| match (search, subject) {
-                (Some(search), Some(subject)) => offer(search, subject, known, &grown, singles),
+                (Some(search), Some(subject)) => {
+                    let changed = &changes[&change_key(subject)];
+                    offer(search, subject, known, &grown, singles, changed)
+                }
                 _ => Vec::new(),
             })
             .collect();
@@ -135,14 +140,53 @@ fn picture_of<'a>(
         .map(|c| &c.pictures[index])
 }
 
+/// Which pictures and thresholds the searches compare: the key of [`single_changes`].
+fn change_key(subject: &Subject) -> (usize, u64) {
+    (subject.picture, subject.spec.rule.threshold.to_bits())
+}
+
+/// Where each single fault changes the golden picture (`None` for speckled faults, which are not
+/// offered), for every picture and threshold an image still searched compares: made once for
+/// all the steps and images of the render.
+fn single_changes(
+    searches: &[Option<Search>],
+    subjects: &[Option<Subject>],
+    singles: &[Candidate],
+) -> HashMap<(usize, u64), Vec<Option<Mask>>> {
+    let mut wanted: Vec<(usize, u64, &RgbImage)> = Vec::new();
+    for (_, subject) in searches.iter().zip(subjects).filter(|(search, _)| search.is_some()) {
+        if let Some(subject) = subject {
+            let (picture, threshold) = change_key(subject);
+            if !wanted.iter().any(|w| (w.0, w.1) == (picture, threshold)) {
+                wanted.push((picture, threshold, subject.golden));
+            }
+        }
+    }
+    wanted
+        .into_par_iter()
+        .map(|(picture, threshold, golden)| {
+            let masks = singles
+                .iter()
+                .map(|c| {
+                    (!c.set.faults().any(Fault::is_speckle))
+                        .then(|| Mask::differing(&c.pictures[picture], golden, f64::from_bits(threshold)))
+                })
+                .collect();
+            ((picture, threshold), masks)
+        })
+        .collect()
+}
+
 /// Each set of the beam with each of the [`OFFERED`] single faults that best cover what it left
-/// failing: (the set's place in the beam, the grown set).
+/// failing: (the set's place in the beam, the grown set). `changes` holds where each single
+/// changes the golden picture.
 fn offer(
     search: &mut Search,
     subject: &Subject,
     known: &[&Candidate],
     grown: &[Candidate],
     singles: &[Candidate],
+    changes: &[Option<Mask>],
 ) -> Vec<(usize, FaultSet)> {
     let threshold = subject.spec.rule.threshold;
     let mut offers = Vec::new();
@@ -150,21 +194,19 @@ fn offer(
         let Some(base_picture) = picture_of(&base.set, known, grown, subject.picture) else {
             continue;
         };
-        let failing = failing_mask(base_picture, &subject.student, threshold);
-        let base_changed = changed_mask(base_picture, subject.golden, threshold);
-        let left = failing.iter().filter(|f| **f).count();
+        let failing = Mask::differing(base_picture, &subject.student, threshold);
+        let base_changed = Mask::differing(base_picture, subject.golden, threshold);
+        let left = failing.count();
         let mut ranked: Vec<(bool, i64, FaultSet)> = singles
             .iter()
-            .filter(|c| !c.set.faults().any(Fault::is_speckle))
-            .filter_map(|c| {
+            .zip(changes)
+            .filter_map(|(c, changed)| {
+                let changed = changed.as_ref()?;
                 let set = candidates::pair(&base.set, &c.set)?;
-                let changed = changed_mask(&c.pictures[subject.picture], subject.golden, threshold);
-                let covered = changed.iter().zip(&failing).filter(|(c, f)| **c && **f).count();
+                let covered = changed.count_both(&failing);
                 // Where the set already changed the golden picture, what the fault would do on
                 // top of it cannot be told from the pictures.
-                let spoiled = (0..changed.len())
-                    .filter(|&i| changed[i] && !failing[i] && !base_changed[i])
-                    .count();
+                let spoiled = changed.count_outside(&failing, &base_changed);
                 let enough = covered as f64 >= REAL_SHARE * left as f64 && covered > spoiled;
                 let unwritten = c.set.faults().all(|f| f.unfinished_part().is_some());
                 enough.then_some((unwritten, covered as i64 - spoiled as i64, set))
@@ -274,16 +316,4 @@ fn distance(a: &crate::rgb_image::Rgb, b: &crate::rgb_image::Rgb) -> f64 {
 
 fn close(a: &crate::rgb_image::Rgb, b: &crate::rgb_image::Rgb, threshold: f64) -> bool {
     a.0.iter().zip(b.0).all(|(x, y)| f64::from(x.abs_diff(y)) <= threshold)
-}
-
-fn failing_mask(picture: &RgbImage, student: &RgbImage, threshold: f64) -> Vec<bool> {
-    picture
-        .pixels()
-        .zip(student.pixels())
-        .map(|(p, s)| !close(p, s, threshold))
-        .collect()
-}
-
-fn changed_mask(picture: &RgbImage, golden: &RgbImage, threshold: f64) -> Vec<bool> {
-    failing_mask(picture, golden, threshold)
 }

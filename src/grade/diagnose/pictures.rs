@@ -19,7 +19,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
 use super::super::golden::CacheMode;
-use crate::atomic_write::{link_file, write_file_atomic};
+use crate::atomic_write::{link_file, publish_file, write_file_atomic};
 use crate::case::Case;
 use crate::fault::FaultSet;
 use crate::film::{Film, Picture, Tonemap, encode_png, picture_with_faults};
@@ -118,7 +118,7 @@ impl<'a> FaultPictures<'a> {
                 continue;
             };
             let stored =
-                content.exists() || encode_png(&image).is_ok_and(|bytes| write_file_atomic(&content, &bytes).is_ok());
+                content.exists() || encode_png(&image).is_ok_and(|bytes| publish_file(&content, &bytes).is_ok());
             if !(stored && link_file(&content, &path).is_ok())
                 && let Ok(bytes) = encode_png(&image)
             {
