@@ -45,16 +45,10 @@ pub fn replace_file(path: &Path, bytes: &[u8]) -> Result<(), AtomicWriteError> {
         path: path.to_path_buf(),
         source,
     };
-    static NEXT: AtomicU64 = AtomicU64::new(0);
     let dir = parent_folder(path);
     fs::create_dir_all(dir).map_err(error)?;
-    // Created like any output (the umask decides who may read it), under a name no other
-    // writer in this or another process uses.
-    let temp = dir.join(format!(
-        ".goldray-{}-{}.tmp",
-        std::process::id(),
-        NEXT.fetch_add(1, Ordering::Relaxed)
-    ));
+    // Created like any output (the umask decides who may read it).
+    let temp = temporary_beside(dir, "tmp");
     let written = File::create_new(&temp)
         .and_then(|mut file| file.write_all(bytes))
         .and_then(|()| fs::rename(&temp, path));
@@ -68,12 +62,7 @@ pub fn replace_file(path: &Path, bytes: &[u8]) -> Result<(), AtomicWriteError> {
 /// same content-addressed file leave one file, whoever came first: the bytes go to a synced
 /// temporary file beside `path`, which is then linked to `path` (a link never replaces).
 pub fn publish_file(path: &Path, bytes: &[u8]) -> Result<(), AtomicWriteError> {
-    static NEXT: AtomicU64 = AtomicU64::new(0);
-    let temp = parent_folder(path).join(format!(
-        ".goldray-{}-{}.new",
-        std::process::id(),
-        NEXT.fetch_add(1, Ordering::Relaxed)
-    ));
+    let temp = temporary_beside(parent_folder(path), "new");
     write_file_atomic(&temp, bytes)?;
     let published = match fs::hard_link(&temp, path) {
         Err(e) if e.kind() != io::ErrorKind::AlreadyExists => Err(AtomicWriteError::Write {
@@ -94,19 +83,25 @@ pub fn link_file(original: &Path, link: &Path) -> Result<(), AtomicWriteError> {
         path: link.to_path_buf(),
         source,
     };
-    static NEXT: AtomicU64 = AtomicU64::new(0);
     let dir = parent_folder(link);
     fs::create_dir_all(dir).map_err(error)?;
-    let temp = dir.join(format!(
-        ".goldray-{}-{}.link",
-        std::process::id(),
-        NEXT.fetch_add(1, Ordering::Relaxed)
-    ));
+    let temp = temporary_beside(dir, "link");
     let linked = fs::hard_link(original, &temp).and_then(|()| fs::rename(&temp, link));
     if linked.is_err() {
         let _ = fs::remove_file(&temp);
     }
     linked.map_err(error)
+}
+
+/// A name in `dir` that no other writer in this or another process uses, for a file that is
+/// renamed or linked into place.
+fn temporary_beside(dir: &Path, extension: &str) -> PathBuf {
+    static NEXT: AtomicU64 = AtomicU64::new(0);
+    dir.join(format!(
+        ".goldray-{}-{}.{extension}",
+        std::process::id(),
+        NEXT.fetch_add(1, Ordering::Relaxed)
+    ))
 }
 
 /// Checks, before any work is spent on it, that `path` could be written: it is not a folder, and
