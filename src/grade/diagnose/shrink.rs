@@ -36,12 +36,11 @@ pub(super) fn shrink(
         .collect();
     parts.sort_by_key(|f| f.bit());
     parts.dedup();
-    let open: Vec<usize> = (0..subjects.len())
-        .filter(|&i| {
-            subjects[i]
-                .as_ref()
-                .is_some_and(|subject| !scores[i].iter().any(|s| passes(s, &subject.spec.rule)))
-        })
+    let open: Vec<(usize, &Subject)> = subjects
+        .iter()
+        .enumerate()
+        .filter_map(|(i, subject)| Some((i, subject.as_ref()?)))
+        .filter(|(i, subject)| !scores[*i].iter().any(|s| passes(s, &subject.spec.rule)))
         .collect();
     if parts.len() < 2 || open.is_empty() {
         return Vec::new();
@@ -52,18 +51,15 @@ pub(super) fn shrink(
     };
     // Each image the whole set explains, with the set it is down to and the parts taken out that
     // changed nothing in its picture.
-    let mut current: Vec<(usize, FaultSet, Vec<Fault>)> = open
+    let mut current: Vec<(usize, &Subject, FaultSet, Vec<Fault>)> = open
         .into_iter()
-        .filter(|&i| {
-            let subject = subjects[i].as_ref().expect("open images have a subject");
-            subject.score(&all).is_some_and(|s| s.explains(&subject.spec.rule))
-        })
-        .map(|i| (i, everything, Vec::new()))
+        .filter(|(_, subject)| subject.score(&all).is_some_and(|s| s.explains(&subject.spec.rule)))
+        .map(|(i, subject)| (i, subject, everything, Vec::new()))
         .collect();
     let mut rendered = vec![all];
     for part in parts {
         let mut wanted: Vec<FaultSet> = Vec::new();
-        for (_, set, _) in &current {
+        for (_, _, set, _) in &current {
             let without = set.without(part);
             if set.contains(part) && set.len() > 1 && !wanted.contains(&without) && find(&rendered, &without).is_none()
             {
@@ -71,11 +67,10 @@ pub(super) fn shrink(
             }
         }
         rendered.extend(wanted.into_par_iter().filter_map(get).collect::<Vec<_>>());
-        for (i, set, hidden) in &mut current {
+        for (_, subject, set, hidden) in &mut current {
             if !set.contains(part) || set.len() == 1 {
                 continue;
             }
-            let subject = subjects[*i].as_ref().expect("open images have a subject");
             let without = set.without(part);
             let (Some(with_part), Some(without_part)) = (find(&rendered, set), find(&rendered, &without)) else {
                 continue;
@@ -115,17 +110,15 @@ pub(super) fn shrink(
         sets
     };
     let mut wanted: Vec<FaultSet> = Vec::new();
-    for (i, set, hidden) in &current {
-        let picture = subjects[*i].as_ref().expect("open images have a subject").picture;
-        for other in swapped(set, hidden, picture) {
+    for (_, subject, set, hidden) in &current {
+        for other in swapped(set, hidden, subject.picture) {
             if !wanted.contains(&other) && find(&rendered, &other).is_none() {
                 wanted.push(other);
             }
         }
     }
     rendered.extend(wanted.into_par_iter().filter_map(get).collect::<Vec<_>>());
-    for (i, set, hidden) in current {
-        let subject = subjects[i].as_ref().expect("open images have a subject");
+    for (i, subject, set, hidden) in current {
         let Some(shrunk) = find(&rendered, &set) else {
             continue;
         };
