@@ -87,14 +87,12 @@ fn asks_for_course_help(args: &[std::ffi::OsString]) -> bool {
     }
 }
 
-/// Parses the command line (rewriting the course's single-dash flags first), runs the command
-/// and turns its outcome into the process's exit code.
 /// Asks glibc's allocator to keep memory the process frees for its next allocations instead of
 /// handing it back to the kernel at once. goldray allocates and frees pictures of megabytes by
 /// the thousand (a class's PNGs, the mistakes' pictures of a diagnosis); with glibc's defaults
 /// many went back to the kernel on free, and every page came back zeroed on the next use: a
-/// warm diagnosed grading of a 20-student class at 800×800 spent 2.5 s of its 9 s of processor
-/// time in the kernel, 1.2–1.5 s with these settings (same peak memory). Blocks up to 32 MB (the
+/// warm diagnosed grading of a 20-student class at 800×800 spent 1.6–2.3 s of its 8–9 s of
+/// processor time in the kernel, 1.1–1.2 s with these settings (same peak memory). Blocks up to 32 MB (the
 /// largest glibc takes) come from the heap, which keeps up to 1 GB of free space at its top.
 fn keep_freed_memory() {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
@@ -105,6 +103,8 @@ fn keep_freed_memory() {
     }
 }
 
+/// Parses the command line (rewriting the course's single-dash flags first), runs the command
+/// and turns its outcome into the process's exit code.
 pub fn main() -> ExitCode {
     // The sandbox's init, started by the library for each command it runs: first thing, before
     // anything could start a thread (see goldray::sandbox).

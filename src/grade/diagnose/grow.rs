@@ -153,18 +153,19 @@ fn single_changes(
     subjects: &[Option<Subject>],
     singles: &[Candidate],
 ) -> HashMap<(usize, u64), Vec<Option<Mask>>> {
-    let mut wanted: Vec<(usize, u64, &RgbImage)> = Vec::new();
-    for (_, subject) in searches.iter().zip(subjects).filter(|(search, _)| search.is_some()) {
-        if let Some(subject) = subject {
-            let (picture, threshold) = change_key(subject);
-            if !wanted.iter().any(|w| (w.0, w.1) == (picture, threshold)) {
-                wanted.push((picture, threshold, subject.golden));
-            }
+    let mut wanted: Vec<((usize, u64), &RgbImage)> = Vec::new();
+    let searched = searches
+        .iter()
+        .zip(subjects)
+        .filter_map(|(search, subject)| search.as_ref().and(subject.as_ref()));
+    for subject in searched {
+        if !wanted.iter().any(|(key, _)| *key == change_key(subject)) {
+            wanted.push((change_key(subject), subject.golden));
         }
     }
     wanted
         .into_par_iter()
-        .map(|(picture, threshold, golden)| {
+        .map(|((picture, threshold), golden)| {
             let masks = singles
                 .iter()
                 .map(|c| {

@@ -4,6 +4,7 @@
 //! words ANDed and counted, where masks of one byte a pixel cost a fresh 640 KB allocation (and
 //! its page faults) for every question at 800×800.
 
+use super::residual::code_limit;
 use crate::rgb_image::RgbImage;
 
 /// A set of pixels of one picture size, one bit each in row-major order.
@@ -14,14 +15,9 @@ pub(super) struct Mask {
 
 impl Mask {
     /// The pixels where `a` and `b` differ by more than `threshold` codes in some channel (the
-    /// pictures have the same size). A difference in codes is an integer, so it exceeds the
-    /// threshold exactly when it exceeds the threshold's integer part.
+    /// pictures have the same size), by the residual's rule ([`code_limit`]).
     pub fn differing(a: &RgbImage, b: &RgbImage, threshold: f64) -> Mask {
-        let limit = if threshold < 0.0 {
-            -1
-        } else {
-            threshold.min(255.0) as i32
-        };
+        let limit = code_limit(threshold);
         let words = a
             .as_raw()
             .chunks(64 * 3)

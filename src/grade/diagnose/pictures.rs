@@ -14,7 +14,7 @@
 
 use std::collections::HashMap;
 use std::fs;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
@@ -112,29 +112,27 @@ impl<'a> FaultPictures<'a> {
         if self.mode == CacheMode::ReadOnly {
             return;
         }
+        let Some(dir) = &self.dir else {
+            return;
+        };
         for picture in &self.stored {
             let image = picture_with_faults(film, *picture, self.tonemap, faults);
-            let (Some(path), Some(content)) = (self.entry(label, *picture), self.content_entry(&image)) else {
-                continue;
+            let (path, content) = (entry_in(dir, label, *picture), content_entry(dir, &image));
+            // Encoded at most once: for the stored content, or for a copy where links fail.
+            let mut png = None;
+            let stored = content.exists() || {
+                png = encode_png(&image).ok();
+                png.as_ref().is_some_and(|bytes| publish_file(&content, bytes).is_ok())
             };
-            let stored =
-                content.exists() || encode_png(&image).is_ok_and(|bytes| publish_file(&content, &bytes).is_ok());
-            if !(stored && link_file(&content, &path).is_ok())
-                && let Ok(bytes) = encode_png(&image)
-            {
-                let _ = write_file_atomic(&path, &bytes);
+            if !(stored && link_file(&content, &path).is_ok()) {
+                if png.is_none() {
+                    png = encode_png(&image).ok();
+                }
+                if let Some(bytes) = &png {
+                    let _ = write_file_atomic(&path, bytes);
+                }
             }
         }
-    }
-
-    /// Where the picture's content is stored once for every set that draws it.
-    fn content_entry(&self, image: &RgbImage) -> Option<PathBuf> {
-        let mut hasher = blake3::Hasher::new();
-        hasher.update(&image.width().to_le_bytes());
-        hasher.update(&image.height().to_le_bytes());
-        hasher.update(image.as_raw());
-        let name = format!("{}.png", &hasher.finalize().to_hex()[..32]);
-        Some(self.dir.as_ref()?.join(CONTENT_DIR).join(name))
     }
 
     /// The pictures a program with `faults` writes, in the order of [`FaultPictures::pictures`]:
@@ -195,12 +193,7 @@ impl<'a> FaultPictures<'a> {
     }
 
     fn entry(&self, label: &str, picture: Picture) -> Option<PathBuf> {
-        Some(
-            self.dir
-                .as_ref()?
-                .join(label)
-                .join(format!("{}.png", picture_name(picture))),
-        )
+        Some(entry_in(self.dir.as_ref()?, label, picture))
     }
 
     /// Every picture of the set, or nothing: a partial or damaged entry is rendered again. A file
@@ -235,6 +228,21 @@ impl<'a> FaultPictures<'a> {
 /// The folder of a render's cache that holds each distinct picture once.
 const CONTENT_DIR: &str = "by-content";
 
+/// A set's picture in the render's cache folder `dir`.
+fn entry_in(dir: &Path, label: &str, picture: Picture) -> PathBuf {
+    dir.join(label).join(format!("{}.png", picture_name(picture)))
+}
+
+/// Where a picture's content is stored once for every set that draws it.
+fn content_entry(dir: &Path, image: &RgbImage) -> PathBuf {
+    let mut hasher = blake3::Hasher::new();
+    hasher.update(&image.width().to_le_bytes());
+    hasher.update(&image.height().to_le_bytes());
+    hasher.update(image.as_raw());
+    dir.join(CONTENT_DIR)
+        .join(format!("{}.png", &hasher.finalize().to_hex()[..32]))
+}
+
 /// What tells one file from another whatever its names: device and inode on Unix (hard links
 /// share them); elsewhere the path, so that only a file's own name finds it again.
 #[cfg(unix)]
@@ -243,13 +251,13 @@ type FileIdentity = (u64, u64);
 type FileIdentity = PathBuf;
 
 #[cfg(unix)]
-fn file_identity(path: &std::path::Path) -> Option<FileIdentity> {
+fn file_identity(path: &Path) -> Option<FileIdentity> {
     use std::os::unix::fs::MetadataExt;
     let meta = fs::metadata(path).ok()?;
     Some((meta.dev(), meta.ino()))
 }
 
 #[cfg(not(unix))]
-fn file_identity(path: &std::path::Path) -> Option<FileIdentity> {
+fn file_identity(path: &Path) -> Option<FileIdentity> {
     fs::metadata(path).ok().map(|_| path.to_path_buf())
 }

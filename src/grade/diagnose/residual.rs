@@ -11,23 +11,28 @@ use crate::rgb_image::RgbImage;
 /// this works on the raw bytes in runs of [`RUN`] pixels that the compiler vectorises, with the
 /// machine's widest vectors ([`crate::simd::dispatch`]; the sums are integers, the same on every
 /// path): the squared differences summed in integers and each byte's verdict kept, then the
-/// verdicts of a pixel's three channels joined. A difference in codes is an integer, so it
-/// exceeds the threshold exactly when it exceeds the threshold's integer part.
+/// verdicts of a pixel's three channels joined ([`code_limit`]).
 pub fn residual(expected: &RgbImage, actual: &RgbImage, threshold: f64) -> Residual {
-    let limit = if threshold < 0.0 {
-        -1
-    } else {
-        threshold.min(255.0) as i32
-    };
     let (failing, sum_sq) = crate::simd::dispatch(Runs {
         expected: expected.as_raw(),
         actual: actual.as_raw(),
-        limit,
+        limit: code_limit(threshold),
     });
     let pixels = (expected.width() as usize * expected.height() as usize).max(1);
     Residual {
         failing_fraction: failing as f64 / pixels as f64,
         rmse: (sum_sq as f64 / (3 * pixels) as f64).sqrt(),
+    }
+}
+
+/// The largest difference in codes that is not over `threshold`: a difference in codes is an
+/// integer, so it exceeds the threshold exactly when it exceeds the threshold's integer part
+/// (every difference exceeds a negative threshold).
+pub fn code_limit(threshold: f64) -> i32 {
+    if threshold < 0.0 {
+        -1
+    } else {
+        threshold.min(255.0) as i32
     }
 }
 
