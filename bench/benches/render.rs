@@ -98,16 +98,21 @@ fn primary_rays(c: &mut Criterion) {
     group.sample_size(10);
     group.throughput(Throughput::Elements(u64::from(SIDE * SIDE)));
     for threads in [1, 2] {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .expect("a thread pool");
+        let pool = pool(threads);
         group.bench_function(format!("blob_1.3M/{threads}_threads"), |b| {
             let scene = blob_scene();
             b.iter(|| pool.install(|| render(&scene, &options, &Silent)))
         });
     }
     group.finish();
+}
+
+/// A pool of `threads` workers, for a benchmark measured at a given thread count.
+fn pool(threads: usize) -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .expect("a thread pool")
 }
 
 /// SplitMix64 of a ray index and one of eight streams: every ray is a pure function of its index.
@@ -144,10 +149,7 @@ fn incoherent_rays(c: &mut Criterion) {
     group.sample_size(10);
     group.throughput(Throughput::Elements(INCOHERENT_RAYS as u64));
     for threads in [1, 2] {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .expect("a thread pool");
+        let pool = pool(threads);
         group.bench_function(format!("blob_1.3M/{threads}_threads"), |b| {
             let scene = blob_scene();
             b.iter(|| {
@@ -179,10 +181,7 @@ fn bvh_build(c: &mut Criterion) {
     group.sample_size(10);
     group.throughput(Throughput::Elements(BLOB_TRIANGLES));
     for threads in [1, 2] {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .expect("a thread pool");
+        let pool = pool(threads);
         group.bench_function(format!("blob_1.3M/{threads}_threads"), |b| {
             b.iter(|| pool.install(|| Bvh::build(&bounds)))
         });
@@ -266,10 +265,7 @@ fn ensure_blob_1m(path: &Path) {
 fn stats_overhead(c: &mut Criterion) {
     let cases = Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("cases");
     ensure_blob_1m(&cases.join("bench/assets/blob_1m.obj"));
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .expect("a thread pool");
+    let pool = pool(1);
     let mut group = c.benchmark_group("stats_overhead");
     group.sample_size(10);
     for path in [cases.join("bench/blob_1m.toml"), cases.join("mirrors.toml")] {
@@ -319,10 +315,7 @@ fn only_what_is_required(c: &mut Criterion) {
         ("4_samples_with_aovs", Vec::new(), options(false, 4, true)),
         ("4_samples_without_aovs", Vec::new(), options(false, 4, false)),
     ];
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .expect("a thread pool");
+    let pool = pool(1);
     let mut group = c.benchmark_group("only_what_is_required");
     group.sample_size(10);
     for (name, lights, options) in &renders {
