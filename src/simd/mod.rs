@@ -20,6 +20,7 @@
 use std::ops::{Add, Div, Mul, Neg, Sub};
 use std::sync::atomic::{AtomicU8, Ordering};
 
+pub mod math;
 mod portable;
 #[cfg(target_arch = "x86_64")]
 mod x86;
@@ -206,6 +207,12 @@ pub trait Isa: Copy + 'static {
     /// Asks for the cache line holding `address` to be loaded, without waiting for it (a hint
     /// that changes no result; nothing on the portable path).
     fn prefetch<T>(address: *const T);
+    /// Each lane `x` (positive and normal) as `(m, e)`, `x = m·2^e` with `m` in [1, 2) and `e` an
+    /// integer held as a float: read from the bits, so exact. Other lanes give unspecified
+    /// values, the same on every path.
+    fn split_exponent(x: Self::F32x8) -> (Self::F32x8, Self::F32x8);
+    /// `2^n` for each lane `n`, an integer in [-126, 127] held as a float: made from the bits.
+    fn power_of_two(n: Self::F32x8) -> Self::F32x8;
 }
 
 /// `N` floating-point lanes with the same operation applied to each.

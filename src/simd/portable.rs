@@ -40,6 +40,20 @@ impl Isa for Portable {
 
     #[inline(always)]
     fn prefetch<T>(_: *const T) {}
+
+    #[inline(always)]
+    fn split_exponent(x: Array<f32, 8>) -> (Array<f32, 8>, Array<f32, 8>) {
+        let bits = x.0.map(f32::to_bits);
+        (
+            Array(bits.map(|b| f32::from_bits((b & 0x007f_ffff) | 0x3f80_0000))),
+            Array(bits.map(|b| (((b >> 23) & 0xff) as i32 - 127) as f32)),
+        )
+    }
+
+    #[inline(always)]
+    fn power_of_two(n: Array<f32, 8>) -> Array<f32, 8> {
+        Array(n.0.map(|n| f32::from_bits(((n as i32 + 127) as u32) << 23)))
+    }
 }
 
 /// `N` lanes of `T`.

@@ -92,6 +92,31 @@ macro_rules! isa {
                 // SAFETY: a prefetch never faults, whatever the address.
                 unsafe { _mm_prefetch::<_MM_HINT_T0>(address.cast()) }
             }
+
+            #[inline(always)]
+            fn split_exponent(x: F32x8) -> (F32x8, F32x8) {
+                unsafe {
+                    let bits = _mm256_castps_si256(x.0);
+                    let significand = _mm256_or_si256(
+                        _mm256_and_si256(bits, _mm256_set1_epi32(0x007f_ffff)),
+                        _mm256_set1_epi32(0x3f80_0000),
+                    );
+                    let biased = _mm256_srli_epi32::<23>(_mm256_and_si256(bits, _mm256_set1_epi32(0x7f80_0000)));
+                    let exponent = _mm256_sub_epi32(biased, _mm256_set1_epi32(127));
+                    (
+                        F32x8(_mm256_castsi256_ps(significand)),
+                        F32x8(_mm256_cvtepi32_ps(exponent)),
+                    )
+                }
+            }
+
+            #[inline(always)]
+            fn power_of_two(n: F32x8) -> F32x8 {
+                unsafe {
+                    let biased = _mm256_add_epi32(_mm256_cvttps_epi32(n.0), _mm256_set1_epi32(127));
+                    F32x8(_mm256_castsi256_ps(_mm256_slli_epi32::<23>(biased)))
+                }
+            }
         }
     };
 }

@@ -4,6 +4,9 @@
 
 use std::sync::LazyLock;
 
+/// The longest kernel, in taps (the spatial filters have 21 at the default viewing setup).
+pub(super) const MAX_TAPS: usize = 32;
+
 /// Pixels per degree of visual angle: `nv_flip::DEFAULT_PIXELS_PER_DEGREE`, a 0.7 m viewing
 /// distance from a 0.7 m wide 4K monitor. A test checks it against the crate.
 pub(super) const PIXELS_PER_DEGREE: f32 = 67.0;

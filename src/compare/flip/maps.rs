@@ -7,7 +7,8 @@ use std::ops::Range;
 
 use crate::rgb_image::RgbImage;
 
-use super::color::{Perceiver, color_error, feature_input, flip_error, srgb_to_ycxcz, strengths};
+use super::color::{feature_input, srgb_to_ycxcz};
+use super::filter::Band;
 use super::kernels::KERNELS;
 
 /// What FLIP's per-pixel error reads of one picture, over a band of its rows.
@@ -16,47 +17,9 @@ pub(super) struct Maps {
     width: usize,
     rows: Range<usize>,
     /// The spatially filtered YCxCz, one plane per channel.
-    color: [Vec<f32>; 3],
+    pub(super) color: [Vec<f32>; 3],
     /// The edge and point responses `dx, dy, ddx, ddy`.
-    features: [Vec<f32>; 4],
-}
-
-/// What FLIP keeps of a reference picture to compare others with it: its maps over the whole
-/// picture and what its half of every pixel's error needs of them.
-#[derive(Clone)]
-pub(in crate::compare) struct Reference {
-    pub(super) maps: Maps,
-    /// Each pixel's filtered colour as FLIP compares colours ([`super::color::perceived`]).
-    pub(super) perceived: Vec<[f32; 3]>,
-    /// Each pixel's edge and point [`strengths`].
-    pub(super) strengths: Vec<[f32; 2]>,
-}
-
-impl std::fmt::Debug for Reference {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "flip::Reference({} pixels)", self.perceived.len())
-    }
-}
-
-impl Reference {
-    pub(super) fn of(picture: &RgbImage) -> Reference {
-        let maps = Maps::of(picture, 0..picture.height() as usize);
-        let pixels = maps.color[0].len();
-        let mut perceiver = Perceiver::default();
-        let perceived = (0..pixels).map(|p| perceiver.perceived(maps.color(p))).collect();
-        Reference {
-            perceived,
-            strengths: (0..pixels).map(|p| strengths(maps.features(p))).collect(),
-            maps,
-        }
-    }
-
-    /// FLIP's error at `pixel` of a picture whose filtered colour and feature responses there are
-    /// `color` and `features` (the colour perceived through `perceiver`).
-    pub(super) fn error(&self, pixel: usize, color: [f32; 3], features: [f32; 4], perceiver: &mut Perceiver) -> f32 {
-        let color_error = color_error(self.perceived[pixel], perceiver.perceived(color));
-        flip_error(color_error, self.strengths[pixel], strengths(features))
-    }
+    pub(super) features: [Vec<f32>; 4],
 }
 
 impl Maps {
@@ -149,15 +112,6 @@ impl Maps {
     }
 }
 
-/// The rows a band's maps cover and the rows they read.
-struct Band {
-    width: usize,
-    height: usize,
-    /// The picture's rows the planes hold (the band and the filters' reach).
-    read: Range<usize>,
-    rows: Range<usize>,
-}
-
 /// The working planes of one filtering, kept by each thread: a class's pictures are filtered one
 /// after another, and planes made afresh for each cost a page fault every 4 KB (most of the
 /// system time of grading a class).
@@ -172,48 +126,4 @@ struct Scratch {
 
 thread_local! {
     static SCRATCH: RefCell<Scratch> = RefCell::default();
-}
-
-impl Band {
-    /// Each row of `plane` (the rows `read`) filtered by `taps` into `out`, the row's end values
-    /// repeated past its ends.
-    fn horizontal(&self, plane: &[f32], taps: &[f32], out: &mut Vec<f32>) {
-        let (width, radius) = (self.width, taps.len() / 2);
-        out.clear();
-        out.resize(plane.len(), 0.0);
-        let mut padded = vec![0.0f32; width + 2 * radius];
-        for (row, out_row) in plane.chunks_exact(width).zip(out.chunks_exact_mut(width)) {
-            for (i, p) in padded.iter_mut().enumerate() {
-                *p = row[i.saturating_sub(radius).min(width - 1)];
-            }
-            for (t, &tap) in taps.iter().enumerate() {
-                for (o, &v) in out_row.iter_mut().zip(&padded[t..t + width]) {
-                    *o += tap * v;
-                }
-            }
-        }
-    }
-
-    /// The band's rows of `plane` (the rows `read`) filtered down the columns by `taps`, the
-    /// picture's first and last rows repeated past its ends.
-    fn vertical(&self, plane: &[f32], taps: &[f32]) -> Vec<f32> {
-        let mut out = Vec::new();
-        self.vertical_into(plane, taps, &mut out);
-        out
-    }
-
-    /// [`Band::vertical`] into `out`.
-    fn vertical_into(&self, plane: &[f32], taps: &[f32], out: &mut Vec<f32>) {
-        let (width, radius) = (self.width, taps.len() / 2);
-        out.clear();
-        out.resize(self.rows.len() * width, 0.0);
-        for (y, out_row) in self.rows.clone().zip(out.chunks_exact_mut(width)) {
-            for (t, &tap) in taps.iter().enumerate() {
-                let source = (y + t).saturating_sub(radius).min(self.height - 1) - self.read.start;
-                for (o, &v) in out_row.iter_mut().zip(&plane[source * width..(source + 1) * width]) {
-                    *o += tap * v;
-                }
-            }
-        }
-    }
 }

@@ -5,12 +5,9 @@
 
 use crate::rgb_image::RgbImage;
 
-use super::color::{Perceiver, feature_input, srgb_to_ycxcz};
-use super::kernels::{KERNELS, clamped_weight};
-use super::maps::Reference;
-
-/// The longest kernel, in taps (the spatial filters have 21 at the default viewing setup).
-const MAX_TAPS: usize = 32;
+use super::color::{feature_input, srgb_to_ycxcz};
+use super::kernels::{KERNELS, MAX_TAPS, clamped_weight};
+use super::reference::{Reference, TestPixels};
 
 /// The sum of FLIP's error map of `test` against `reference` (`picture`'s maps), which differ
 /// only at the pixel indices `differing`.
@@ -56,18 +53,14 @@ pub(super) fn error_sum(picture: &RgbImage, reference: &Reference, test: &RgbIma
             }
         }
     }
-    let mut perceiver = Perceiver::default();
-    changes
-        .reached
-        .iter()
-        .zip(&changes.sums)
-        .map(|(&p, change)| {
-            let (color, features) = (reference.maps.color(p), reference.maps.features(p));
-            let color = [0, 1, 2].map(|c| color[c] + change[c]);
-            let features = [0, 1, 2, 3].map(|c| features[c] + change[3 + c]);
-            f64::from(reference.error(p, color, features, &mut perceiver))
-        })
-        .sum()
+    let mut reached = TestPixels::with_capacity(changes.reached.len());
+    for (&p, change) in changes.reached.iter().zip(&changes.sums) {
+        let (color, features) = (reference.maps.color(p), reference.maps.features(p));
+        let color = [0, 1, 2].map(|c| color[c] + change[c]);
+        let features = [0, 1, 2, 3].map(|c| features[c] + change[3 + c]);
+        reached.push(p, color, features);
+    }
+    reference.error_sum(&reached)
 }
 
 /// The changes to the maps (colour, then features) at the pixels the differences reach, in the
