@@ -10,7 +10,6 @@
 //! grade every student against the wrong picture.
 
 use std::collections::HashMap;
-use std::collections::hash_map::Entry;
 use std::fs;
 use std::hash::{DefaultHasher, Hash, Hasher};
 use std::path::{Path, PathBuf};
@@ -18,6 +17,7 @@ use std::sync::{Arc, OnceLock};
 use std::time::Instant;
 
 use crate::rgb_image::RgbImage;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::error::GradeError;
@@ -90,106 +90,145 @@ pub fn default_cache_dir() -> PathBuf {
 }
 
 /// Renders (or loads from `cache_dir`) every render an image uses, storing what it rendered in the
-/// cache unless `mode` is read-only.
+/// cache unless `mode` is read-only. The renders are read (or rendered) side by side, and the
+/// images' golden pictures made side by side: reading seven cached 800×800 films one after
+/// another was a sixth of grading a 20-student class.
 pub fn prepare_goldens(
     rubric: &Rubric,
     cache_dir: &Path,
     mode: CacheMode,
     progress: &dyn Progress,
 ) -> Result<Goldens, GradeError> {
-    let mut films: HashMap<usize, Arc<Film>> = HashMap::new();
-    let mut keys: HashMap<usize, String> = HashMap::new();
-    let mut by_key: HashMap<String, usize> = HashMap::new();
-    let mut provenances: HashMap<usize, Provenance> = HashMap::new();
-    let mut renders = Vec::new();
+    // The renders the images use, in the order the images first name them.
+    let mut used: Vec<usize> = Vec::new();
     for spec in &rubric.images {
-        let index = spec.render_index;
-        if films.contains_key(&index) {
-            continue;
+        if !used.contains(&spec.render_index) {
+            used.push(spec.render_index);
         }
+    }
+    let keyed: Vec<(String, Provenance)> = first_error(used.par_iter().map(|&index| {
+        let source = &rubric.renders[index];
+        let provenance = provenance(&source.case).map_err(|error| GradeError::Golden {
+            location: source.location.clone(),
+            render: source.name.clone(),
+            source: Box::new(error),
+        })?;
+        Ok((cache_key(&source.case), provenance))
+    }))?;
+    let mut keys: HashMap<usize, String> = HashMap::new();
+    let mut provenances: HashMap<usize, Provenance> = HashMap::new();
+    // Two differently named renders with the same content are one render.
+    let mut distinct = Vec::new();
+    for (&index, (key, provenance)) in used.iter().zip(keyed) {
+        if !keys.values().any(|known| *known == key) {
+            distinct.push(index);
+        }
+        keys.insert(index, key);
+        provenances.insert(index, provenance);
+    }
+    let made: Vec<(GoldenRender, Film)> = first_error(distinct.par_iter().map(|&index| {
         let source = &rubric.renders[index];
         let started = Instant::now();
-        let key = cache_key(&source.case);
-        // Two differently named renders with the same content are one render.
-        if let Some(&same) = by_key.get(&key) {
-            let film = films[&same].clone();
-            films.insert(index, film);
-            keys.insert(index, key);
-            continue;
-        }
+        let key = &keys[&index];
         let path = cache_dir.join(format!("{key}.exr"));
         let (film, cached, cache_note) = match read_cached(&path, &source.case) {
             Some(film) => (film, true, None),
             None => {
-                let film = {
-                    progress.step(&format!("rendering golden {}", source.name));
-                    render_case_reporting(&source.case, progress)
-                }
-                .map_err(|source_error| GradeError::Golden {
-                    location: source.location.clone(),
-                    render: source.name.clone(),
-                    source: Box::new(source_error),
-                })?;
+                progress.step(&format!("rendering golden {}", source.name));
+                let film =
+                    render_case_reporting(&source.case, progress).map_err(|source_error| GradeError::Golden {
+                        location: source.location.clone(),
+                        render: source.name.clone(),
+                        source: Box::new(source_error),
+                    })?;
                 let note = match mode {
-                    CacheMode::ReadWrite => store(&path, &film, provenance_of(rubric, index, &mut provenances)?).err(),
+                    CacheMode::ReadWrite => store(&path, &film, &provenances[&index]).err(),
                     CacheMode::ReadOnly => Some("not stored: this run only reads the cache".to_owned()),
                 };
                 (film, false, note)
             }
         };
-        renders.push(GoldenRender {
+        let render = GoldenRender {
             render: source.name.clone(),
             key: key.clone(),
             cached,
             seconds: started.elapsed().as_secs_f64(),
             cache_note,
-        });
-        by_key.insert(key.clone(), index);
-        keys.insert(index, key);
-        films.insert(index, Arc::new(film));
+        };
+        Ok((render, film))
+    }))?;
+    let mut renders = Vec::with_capacity(made.len());
+    let mut films_by_key: HashMap<String, Arc<Film>> = HashMap::new();
+    for (render, film) in made {
+        films_by_key.insert(render.key.clone(), Arc::new(film));
+        renders.push(render);
     }
+    let films: HashMap<usize, Arc<Film>> = keys
+        .iter()
+        .map(|(&index, key)| (index, films_by_key[key].clone()))
+        .collect();
 
-    let mut images = Vec::with_capacity(rubric.images.len());
-    let mut image_keys = Vec::with_capacity(rubric.images.len());
-    let mut image_films = Vec::with_capacity(rubric.images.len());
-    let mut allowances = Vec::with_capacity(rubric.images.len());
-    for spec in &rubric.images {
-        provenance_of(rubric, spec.render_index, &mut provenances)?;
-        let film = &films[&spec.render_index];
-        image_keys.push(keys[&spec.render_index].clone());
-        image_films.push(film.clone());
-        let tonemap = rubric.renders[spec.render_index].case.render.tonemap;
-        let statistical = spec.rule.statistical && spec.output == Output::Color;
-        allowances.push(
-            statistical
+    let (allowances, images): (Vec<_>, Vec<_>) = rubric
+        .images
+        .par_iter()
+        .map(|spec| {
+            let film = &films[&spec.render_index];
+            let tonemap = rubric.renders[spec.render_index].case.render.tonemap;
+            let statistical = spec.rule.statistical && spec.output == Output::Color;
+            let allowance = statistical
                 .then(|| png_allowance(film, tonemap).map(Arc::new))
-                .flatten(),
-        );
-        let golden = picture(film, spec.output.picture(), tonemap);
-        images.push(Image::from_rgb8(golden, Path::new(GOLDEN_DIR).join(&spec.file)));
-    }
+                .flatten();
+            let golden = picture(film, spec.output.picture(), tonemap);
+            (
+                allowance,
+                Image::from_rgb8(golden, Path::new(GOLDEN_DIR).join(&spec.file)),
+            )
+        })
+        .unzip();
     Ok(Goldens {
         renders,
         images,
-        keys: image_keys,
-        films: image_films,
+        keys: rubric
+            .images
+            .iter()
+            .map(|spec| keys[&spec.render_index].clone())
+            .collect(),
+        films: rubric
+            .images
+            .iter()
+            .map(|spec| films[&spec.render_index].clone())
+            .collect(),
         allowances,
         provenances,
     })
 }
 
+/// The results of `work` in order, or the first error in that order (whichever finished first),
+/// so that a run with several failing renders names the same one every time.
+fn first_error<T: Send>(
+    work: impl IndexedParallelIterator<Item = Result<T, GradeError>>,
+) -> Result<Vec<T>, GradeError> {
+    let results: Vec<Result<T, GradeError>> = work.collect();
+    results.into_iter().collect()
+}
+
 /// Writes each golden picture to `REPORT/golden/FILE`, for the HTML report.
 /// Each carries the provenance of its render.
 pub fn write_golden_pictures(rubric: &Rubric, goldens: &Goldens, report_dir: &Path) -> Result<(), OutputError> {
-    for (spec, image) in rubric.images.iter().zip(&goldens.images) {
-        let provenance = &goldens.provenances[&spec.render_index];
-        write_golden_png(
-            &report_dir.join(GOLDEN_DIR).join(&spec.file),
-            &image.preview,
-            provenance,
-        )?;
-    }
-    Ok(())
+    let written: Vec<Result<(), OutputError>> = rubric
+        .images
+        .par_iter()
+        .zip(&goldens.images)
+        .map(|(spec, image)| {
+            let provenance = &goldens.provenances[&spec.render_index];
+            write_golden_png(
+                &report_dir.join(GOLDEN_DIR).join(&spec.file),
+                &image.preview,
+                provenance,
+            )
+        })
+        .collect();
+    written.into_iter().collect()
 }
 
 /// The cached film, if there is a readable one of the right size, with the variance channels a
@@ -201,27 +240,6 @@ fn read_cached(path: &Path, case: &Case) -> Option<Film> {
     let trace = &case.render.trace;
     let complete = film.variance.is_some() == (trace.samples > 1);
     (film.width == trace.width && film.height == trace.height && complete).then_some(film)
-}
-
-/// The provenance of the rubric's render `index`, computed once per run (it hashes the case and
-/// its assets): the stable group only, as cached and report files are compared by content.
-fn provenance_of<'a>(
-    rubric: &Rubric,
-    index: usize,
-    known: &'a mut HashMap<usize, Provenance>,
-) -> Result<&'a Provenance, GradeError> {
-    match known.entry(index) {
-        Entry::Occupied(found) => Ok(found.into_mut()),
-        Entry::Vacant(slot) => {
-            let source = &rubric.renders[index];
-            let made = provenance(&source.case).map_err(|error| GradeError::Golden {
-                location: source.location.clone(),
-                render: source.name.clone(),
-                source: Box::new(error),
-            })?;
-            Ok(slot.insert(made))
-        }
-    }
 }
 
 fn store(path: &Path, film: &Film, provenance: &Provenance) -> Result<(), String> {
