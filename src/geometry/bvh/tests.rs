@@ -248,3 +248,91 @@ fn interleaved_rays_each_visit_what_they_visit_alone() {
         }
     }
 }
+
+/// The leaves a packet traversal reaches, by ray: `(lane, first, count)`.
+struct PacketLog(Vec<(usize, u32, u32)>);
+
+impl<I: Isa> PacketVisitor<I> for PacketLog {
+    fn leaf(&mut self, first: u32, count: u32, rays: u32, _t_limit: &mut [Real; PACKET]) {
+        for lane in 0..PACKET {
+            if rays >> lane & 1 != 0 {
+                self.0.push((lane, first, count));
+            }
+        }
+    }
+}
+
+/// Runs [`traverse`] for each ray alone and [`traverse_packet`] for them together.
+struct AloneAndPacket<'a> {
+    nodes: &'a [BvhNode],
+    rays: &'a [Ray],
+    t_max: [Real; PACKET],
+}
+
+impl Kernel for AloneAndPacket<'_> {
+    type Output = (Vec<LeafLog>, PacketLog);
+    fn run<I: Isa>(self) -> Self::Output {
+        let mut alone = vec![LeafLog { calls: Vec::new(), stop_at: usize::MAX }; self.rays.len()];
+        for ((ray, log), &t_max) in self.rays.iter().zip(&mut alone).zip(&self.t_max) {
+            let mut limit_kept = VisitFn(|first, count, t_limit: &mut Real| {
+                log.calls.push((first, count, *t_limit));
+                Visit::Continue
+            });
+            traverse::<I>(self.nodes, ray, t_max, &mut limit_kept);
+        }
+        let lanes = PacketLanes::<I>::new(self.rays).expect("rays that make a packet");
+        let mut packet = PacketLog(Vec::new());
+        let mut t_limit = self.t_max;
+        traverse_packet::<I>(self.nodes, &lanes, (1 << self.rays.len()) - 1, &mut t_limit, &mut packet);
+        (alone, packet)
+    }
+}
+
+#[test]
+fn a_packet_reaches_every_leaf_its_rays_reach_alone() {
+    let points: Vec<Vec3> = (0..3000)
+        .map(|i| Vec3::new((i * 37 % 101) as Real, (i * 11 % 53) as Real, (i * 7 % 29) as Real))
+        .collect();
+    let boxes: Vec<Aabb> = points.iter().map(|&p| Aabb::new(p, p + Vec3::splat(3.0))).collect();
+    let bvh = Bvh::build(&boxes);
+    // Tiles of camera rays from one point, among them one from exactly a box's corner and one
+    // whose rays start inside the boxes; then rays from eight points and a tile with a direction
+    // component of zero.
+    let tile = |origin: Vec3, aim: Vec3, step: Real| -> Vec<Ray> {
+        (0..PACKET)
+            .map(|k| {
+                let offset = Vec3::new((k % 4) as Real, (k / 4) as Real, 0.0) * step;
+                Ray::new(origin, (aim + offset - origin).normalize())
+            })
+            .collect()
+    };
+    let mut packets = vec![
+        tile(Vec3::new(50.0, 26.0, -60.0), Vec3::new(40.0, 20.0, 10.0), 0.7),
+        tile(Vec3::new(-30.0, -20.0, 80.0), Vec3::new(60.0, 30.0, 10.0), 2.5),
+        tile(points[17], Vec3::new(0.0, 0.0, 0.0), 1.0),
+        tile(Vec3::new(50.0, 26.0, 14.0), Vec3::new(90.0, 40.0, 20.0), 0.2),
+    ];
+    let scattered: Vec<Ray> = (0..PACKET)
+        .map(|k| Ray::new(Vec3::new(k as Real, -10.0, -10.0), Vec3::new(1.0, 0.6, 0.3).normalize()))
+        .collect();
+    packets.push(scattered);
+    packets.push(tile(Vec3::new(20.0, 20.0, -50.0), Vec3::new(20.0, 20.0, 10.0), 0.0));
+    let mut t_max = [Real::INFINITY; PACKET];
+    t_max[3] = 40.0;
+    for path in crate::simd::available() {
+        for rays in &packets {
+            let (alone, packet) =
+                crate::simd::dispatch_on(path, AloneAndPacket { nodes: bvh.nodes(), rays, t_max }).unwrap();
+            let reached: usize = alone.iter().map(|alone| alone.calls.len()).sum();
+            assert!(reached > 2 * PACKET, "{path:?}: the rays reach {reached} leaves alone");
+            for (lane, alone) in alone.iter().enumerate() {
+                for &(first, count, _) in &alone.calls {
+                    assert!(
+                        packet.0.contains(&(lane, first, count)),
+                        "{path:?}: ray {lane} reaches leaf {first} alone, not in its packet"
+                    );
+                }
+            }
+        }
+    }
+}
