@@ -6,7 +6,8 @@ use std::time::{Duration, Instant};
 use crate::assignment_outputs::AssignmentOutputs;
 use crate::build_error::BuildError;
 use crate::case::{
-    self, AssignmentOptions, Case, LoadOptions, case_to_toml, case_to_toml_anywhere, load_assignment_scene,
+    self, AssignmentOptions, Case, LoadOptions, LoadedCase, case_to_toml, case_to_toml_anywhere, load_assignment_scene,
+    load_assignment_scene_keeping_source,
 };
 use crate::error::Error;
 use crate::film::{Film, OutputOptions, write_outputs};
@@ -117,8 +118,20 @@ pub fn output_options(case: &Case) -> OutputOptions {
 /// order, each framed by its length), and the render settings. This is the stable group only:
 /// commands add the run's record when asked ([`RecordRun`]).
 pub fn provenance(case: &Case) -> Result<Provenance, Error> {
+    let path = &case.path;
+    let source = std::fs::read(path).map_err(|source| ProvenanceError::Read {
+        path: path.clone(),
+        source,
+    })?;
+    provenance_of(case, &source)
+}
+
+/// [`provenance`] of a case whose file's bytes (`source`) were kept when it was loaded
+/// ([`LoadedCase`]): the hash is of the text that was parsed, and the file is not read again.
+pub fn provenance_of(case: &Case, source: &[u8]) -> Result<Provenance, Error> {
     let mut hash = ContentHash::default();
-    for path in std::iter::once(case.path.clone()).chain(case.assets()) {
+    hash.add(source);
+    for path in case.assets() {
         let bytes = std::fs::read(&path).map_err(|source| ProvenanceError::Read { path, source })?;
         hash.add(&bytes);
     }
@@ -149,7 +162,7 @@ pub fn render_case_file(
     progress: &dyn Progress,
 ) -> Result<Rendered, Error> {
     measured_run(
-        || Ok(case::load(path, load)?),
+        || Ok(case::load_keeping_source(path, load)?),
         progress,
         true,
         record,
@@ -175,7 +188,7 @@ pub fn render_assignment(
     progress: &dyn Progress,
 ) -> Result<Rendered, Error> {
     measured_run(
-        || Ok(load_assignment_scene(scene, options)?),
+        || Ok(load_assignment_scene_keeping_source(scene, options)?),
         progress,
         outputs.writes_aovs(),
         record,
@@ -188,19 +201,19 @@ pub fn render_assignment(
 /// measure: counting costs nothing measurable (`cargo bench -p goldray-bench -- stats_overhead`), so `--stats`
 /// only decides whether the numbers are shown, and can never change what is rendered.
 fn measured_run(
-    load: impl FnOnce() -> Result<Case, Error>,
+    load: impl FnOnce() -> Result<LoadedCase, Error>,
     progress: &dyn Progress,
     aovs: bool,
     record: RecordRun,
     write: impl FnOnce(&Case, &Film, &Provenance) -> Result<Vec<PathBuf>, Error>,
 ) -> Result<Rendered, Error> {
     let start = Instant::now();
-    let case = load()?;
+    let LoadedCase { case, source } = load()?;
     let parse = start.elapsed();
     // Hashing the case and its assets (about 0.1 s for a 50 MB mesh) overlaps the scene build,
     // which reads the same files, rather than adding to it.
     let (provenance, measured) = std::thread::scope(|scope| {
-        let hashing = scope.spawn(|| provenance(&case));
+        let hashing = scope.spawn(|| provenance_of(&case, &source));
         let measured = render_case_measured(&case, progress, aovs);
         let provenance = hashing.join().unwrap_or_else(|panic| std::panic::resume_unwind(panic));
         (provenance, measured)

@@ -311,3 +311,22 @@ fn stamping_replaces_and_stripping_restores_the_encoded_bytes() {
     let film_back = goldray::film::decode_exr(&made.stamp(&exr, "exr").unwrap()).unwrap();
     assert_eq!(film_back, film);
 }
+
+#[test]
+fn a_render_hashes_the_case_text_it_parsed_even_if_the_file_changes_after() {
+    let dir = TempDir::new().unwrap();
+    let case_path = write_case(dir.path(), 7);
+    let loaded = goldray::case::load_keeping_source(&case_path, &Default::default()).unwrap();
+    let as_loaded = hash_of(&[&case_path, &dir.path().join("tri.obj")]);
+    // Another seed on disk after the load: the render in hand is still of seed 7.
+    fs::write(&case_path, tiny_case(8)).unwrap();
+    let hash = |provenance: Provenance| provenance.get(keys::CASE_HASH).map(str::to_owned);
+    let kept = goldray::pipeline::provenance_of(&loaded.case, &loaded.source).unwrap();
+    assert_eq!(hash(kept), Some(as_loaded.clone()));
+    let read_again = goldray::pipeline::provenance(&loaded.case).unwrap();
+    assert_ne!(
+        hash(read_again),
+        Some(as_loaded),
+        "reading the file again sees the new seed"
+    );
+}

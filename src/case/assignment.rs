@@ -15,11 +15,11 @@ use std::path::Path;
 
 use lexer::{Lexer, Result, Token, Vec3, comment_hint, quote};
 
-use super::RenderSettings;
 use super::error::{CaseError, SourceLocation, suggest};
 use super::sections::MAX_BOUNCES;
 use super::spec::{BackgroundSpec, Case, MaterialSpec};
 use super::value::has_usable_length;
+use super::{LoadedCase, RenderSettings};
 use crate::film::Tonemap;
 use crate::located_toml::ReadError;
 use crate::options::{Filter, Precision, Profile, Trace};
@@ -63,6 +63,11 @@ const BLOCKS: &[&str] = &["PerspectiveCamera", "Background", "Lights", "Material
 const AMBIENT_WITHOUT_LIGHTS: [f64; 3] = [1.0; 3];
 
 pub fn load_assignment_scene(path: &Path, options: &AssignmentOptions) -> Result<Case> {
+    load_assignment_scene_keeping_source(path, options).map(|loaded| loaded.case)
+}
+
+/// [`load_assignment_scene`], keeping the file's bytes (see [`LoadedCase`]).
+pub fn load_assignment_scene_keeping_source(path: &Path, options: &AssignmentOptions) -> Result<LoadedCase> {
     let bytes = ReadError::read(path, "case file")?;
     let source = String::from_utf8(bytes).map_err(|e| {
         let valid = e.utf8_error().valid_up_to();
@@ -77,7 +82,11 @@ pub fn load_assignment_scene(path: &Path, options: &AssignmentOptions) -> Result
             ),
         }
     })?;
-    parse_assignment_scene(&source, path, options)
+    let case = parse_assignment_scene(&source, path, options)?;
+    Ok(LoadedCase {
+        case,
+        source: source.into_bytes(),
+    })
 }
 
 /// `path` is not read: it names the scene in messages and anchors its relative asset paths.

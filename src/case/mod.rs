@@ -18,7 +18,9 @@ mod tests;
 use std::path::Path;
 
 pub use crate::located_toml::SourceLocation;
-pub use assignment::{AssignmentOptions, load_assignment_scene, parse_assignment_scene};
+pub use assignment::{
+    AssignmentOptions, load_assignment_scene, load_assignment_scene_keeping_source, parse_assignment_scene,
+};
 pub use error::CaseError;
 pub use export::{case_to_toml, case_to_toml_anywhere};
 pub use sections::MAX_BOUNCES;
@@ -47,8 +49,24 @@ const TOP_LEVEL_KEYS: &[&str] = &[
 ];
 
 pub fn load(path: &Path, options: &LoadOptions) -> Result<Case, CaseError> {
+    load_keeping_source(path, options).map(|loaded| loaded.case)
+}
+
+/// A case and its file's bytes as they were read and parsed, so that a render's provenance
+/// hashes the very text it rendered, read once.
+pub struct LoadedCase {
+    pub case: Case,
+    pub source: Vec<u8>,
+}
+
+/// [`load`], keeping the file's bytes.
+pub fn load_keeping_source(path: &Path, options: &LoadOptions) -> Result<LoadedCase, CaseError> {
     let source = ReadError::read_text(path, "case file")?;
-    parse(&source, path, options)
+    let case = parse(&source, path, options)?;
+    Ok(LoadedCase {
+        case,
+        source: source.into_bytes(),
+    })
 }
 
 /// `path` is not read: it names the case in messages and anchors its relative asset paths.
