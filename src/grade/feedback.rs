@@ -4,8 +4,7 @@
 //! `results.json`), so a student reads the same sentence wherever they are graded.
 
 use super::diagnosis::{Confidence, UNEXPLAINED};
-use super::report::format_points;
-use super::score::{ImageResult, StudentResult};
+use super::score::{ImageResult, StudentResult, format_points};
 
 /// How many of the last lines of a failing command's stderr the feedback quotes: enough for a
 /// compiler's first errors in a short build log.

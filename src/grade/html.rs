@@ -15,7 +15,8 @@ mod program;
 
 use super::golden::GOLDEN_DIR;
 use super::outcome::Outcome;
-use super::report::{ClassReport, flags, format_points};
+use super::report::{ClassReport, flags};
+use super::score::format_points;
 use super::score::{ImageResult, StudentResult, percent};
 use crate::atomic_write::{replace_file, write_file_atomic};
 use crate::compare::Metrics;

@@ -7,11 +7,11 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize, Serializer};
 
 use super::diagnosis::DiagnosisRun;
-use super::diagnosis::UNEXPLAINED;
+use super::feedback::student_feedback;
 use super::golden::GoldenRender;
 use super::lms::{Layout, Refusal, canvas, moodle};
 use super::rubric::{ImageSpec, Rubric};
-use super::score::StudentResult;
+use super::score::{StudentResult, format_points};
 use super::similarity::SimilarPair;
 use super::timing::RunCost;
 use crate::atomic_write::write_file_atomic;
@@ -196,7 +196,13 @@ pub fn lms_csv(report: &ClassReport, platform: Layout) -> Option<String> {
         let total = format_points(student.total);
         rows.push(match platform {
             Layout::Canvas => canvas::row(&student.name, id, &total),
-            _ => moodle::row(id, &student.name, &total, &maximum, &feedback(student)),
+            _ => moodle::row(
+                id,
+                &student.name,
+                &total,
+                &maximum,
+                &moodle::feedback_comments(&student_feedback(student)),
+            ),
         });
     }
     let mut csv = String::new();
@@ -205,40 +211,6 @@ pub fn lms_csv(report: &ClassReport, platform: Layout) -> Option<String> {
         csv.push_str("\r\n");
     }
     Some(csv)
-}
-
-/// What a student reads as feedback: a line per image with its verdict, points and why, and
-/// for an image a known mistake explains, the mistake and where to look for it.
-pub fn feedback(student: &StudentResult) -> String {
-    let mut lines = Vec::new();
-    for image in &student.images {
-        let mut line = format!(
-            "{}: {}, {} of {} points",
-            image.file,
-            image.outcome.word(),
-            format_points(image.points),
-            format_points(image.max_points)
-        );
-        if image.points < image.max_points && !image.explanation.is_empty() {
-            line.push_str(&format!(" ({})", image.explanation));
-        }
-        if let Some(diagnosis) = image.diagnosis.as_ref().filter(|d| d.id != UNEXPLAINED) {
-            line.push_str(&format!(
-                ". Likely mistake: {}: {}",
-                diagnosis.id, diagnosis.explanation
-            ));
-            if !diagnosis.hints.is_empty() {
-                line.push_str(&format!(" Where to look: {}", diagnosis.hints.join("; ")));
-            }
-        }
-        lines.push(line);
-    }
-    lines.push(format!(
-        "Total: {} of {} points",
-        format_points(student.total),
-        format_points(student.max_points)
-    ));
-    lines.join("\n")
 }
 
 /// Each flag of a student's images, as `FILE: flag`.
@@ -287,12 +259,6 @@ fn csv_field(text: &str) -> String {
     } else {
         guarded
     }
-}
-
-/// Points as a person writes them: `2`, `0.5`, `1.33`.
-pub fn format_points(points: f64) -> String {
-    let text = format!("{points:.2}");
-    text.trim_end_matches('0').trim_end_matches('.').to_owned()
 }
 
 /// A distinct file-system and URL-safe name per student folder: ASCII letters, digits, `-` and

@@ -437,6 +437,12 @@ pub fn percent(fraction: f64) -> String {
     format!("{text}%")
 }
 
+/// Points as a person writes them: `2`, `0.5`, `1.33`.
+pub fn format_points(points: f64) -> String {
+    let text = format!("{points:.2}");
+    text.trim_end_matches('0').trim_end_matches('.').to_owned()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

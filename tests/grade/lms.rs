@@ -329,13 +329,19 @@ fn the_platforms_csvs_read_back_with_their_columns_and_values() {
         (brian[1].as_str(), brian[4].as_str(), brian[5].as_str()),
         ("Brian Kernighan", "2", "4")
     );
+    // The self-check's words, lost points first, as Moodle's HTML comment: a line each.
     let feedback = &brian[9];
-    assert!(feedback.contains("color.png: fail, 0 of 2 points"), "{feedback}");
-    assert!(feedback.contains("normals.png: pass, 1 of 1 points"), "{feedback}");
-    assert!(feedback.contains("Total: 2 of 4 points"), "{feedback}");
-    // The darkened band is a mistake the diagnosis names, or says it cannot.
-    assert!(feedback.lines().count() == 4, "{feedback}");
-    assert!(row("104")[9].contains("color.png: missing, 0 of 2 points"));
+    let lines: Vec<&str> = feedback.split("<br>\n").collect();
+    assert_eq!(lines[0], "2 / 4 points", "{feedback}");
+    assert_eq!(lines[1], "color.png: fail, 0 / 2", "{feedback}");
+    assert!(lines[2..].contains(&"normals.png: pass, 1 / 1"), "{feedback}");
+    // The darkened band's explanation and the mistake the diagnosis names (or says it cannot),
+    // indented as in the terminal.
+    assert!(
+        lines[2].starts_with("&nbsp;&nbsp;") && lines[3].starts_with("&nbsp;&nbsp;"),
+        "{feedback}"
+    );
+    assert!(row("104")[9].contains("color.png: missing, 0 / 2"));
     assert!(!dir.join("moodle/grades-canvas.csv").exists());
 }
 

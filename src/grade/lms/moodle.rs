@@ -7,6 +7,8 @@
 //! student, which the worksheet names `Participant ID`. The worksheet's import reads the grade
 //! and the feedback comments by that identifier; the other columns are Moodle's own.
 
+use crate::html_escape::escape;
+
 /// A Moodle submission folder (or a file prefixed like one), its name taken apart.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct MoodleName<'a> {
@@ -72,9 +74,37 @@ pub fn row(participant: &str, full_name: &str, grade: &str, maximum: &str, feedb
     .to_vec()
 }
 
+/// A student's feedback (the self-check's plain text, [`crate::grade::student_feedback`]) as the
+/// worksheet's `Feedback comments`. Moodle stores an imported comment as HTML (the comments
+/// plugin keeps `FORMAT_HTML`), where a newline is a space and a `<` starts a tag: so the text is
+/// escaped (a compiler's `expected '<'` stays text), each line ends in `<br>` and a line's
+/// leading spaces are kept as no-break spaces, and the student reads in Moodle the very lines
+/// `goldray check` and Gradescope show.
+pub fn feedback_comments(plain: &str) -> String {
+    plain
+        .lines()
+        .map(|line| {
+            let text = line.trim_start_matches(' ');
+            "&nbsp;".repeat(line.len() - text.len()) + &escape(text)
+        })
+        .collect::<Vec<_>>()
+        .join("<br>\n")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn feedback_comments_keep_the_lines_and_escape_what_html_would_read() {
+        let plain =
+            "2 / 4 points\ncolor.png: fail, 0 / 2\n  your program: exited 1\n  | main.cpp:3: expected '<' & \"x\"";
+        assert_eq!(
+            feedback_comments(plain),
+            "2 / 4 points<br>\ncolor.png: fail, 0 / 2<br>\n&nbsp;&nbsp;your program: exited 1<br>\n\
+             &nbsp;&nbsp;| main.cpp:3: expected &#39;&lt;&#39; &amp; &quot;x&quot;"
+        );
+    }
 
     #[test]
     fn moodle_folders_and_prefixed_files_come_apart() {
