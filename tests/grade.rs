@@ -17,6 +17,8 @@ mod cli;
 mod integrity;
 #[path = "grade/lms.rs"]
 mod lms;
+#[path = "grade/lms_hostile.rs"]
+mod lms_hostile;
 #[path = "grade/lms_variants.rs"]
 mod lms_variants;
 #[path = "grade/memory.rs"]
