@@ -177,11 +177,17 @@ struct Graded {
     seconds: f64,
 }
 
-fn grade(name: &str, perturbation: Perturbation) -> Graded {
+/// `name` under the tests' scratch folder, emptied of an earlier run's files.
+fn fresh_dir(name: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
     if dir.exists() {
         fs::remove_dir_all(&dir).unwrap();
     }
+    dir
+}
+
+fn grade(name: &str, perturbation: Perturbation) -> Graded {
+    let dir = fresh_dir(name);
     let rubric_path = course_rubric(&dir);
     let rubric = load_rubric(&rubric_path).unwrap();
     let submissions = dir.join("submissions");

@@ -9,10 +9,7 @@ use super::*;
 #[test]
 fn the_mistake_cache_stores_each_picture_once() {
     use std::os::unix::fs::MetadataExt;
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("diagnose-content-cache");
-    if dir.exists() {
-        fs::remove_dir_all(&dir).unwrap();
-    }
+    let dir = fresh_dir("diagnose-content-cache");
     let rubric_path = course_rubric(&dir);
     let rubric = load_rubric(&rubric_path).unwrap();
     let renderers = renderers_for(&rubric, Perturbation::None);

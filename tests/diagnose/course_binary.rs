@@ -9,10 +9,7 @@ use super::*;
 /// as the mistake it was made with.
 #[test]
 fn the_course_binarys_mistakes_are_diagnosed() {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("diagnose-course-binary");
-    if dir.exists() {
-        fs::remove_dir_all(&dir).unwrap();
-    }
+    let dir = fresh_dir("diagnose-course-binary");
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let rubric = dir.join("rubric.toml");
     fs::create_dir_all(&dir).unwrap();
@@ -71,10 +68,7 @@ fn the_course_binarys_mistakes_are_diagnosed() {
 /// that quantised first and then made the mistake could have written) each is diagnosed as it.
 #[test]
 fn the_course_references_with_output_mistakes_are_diagnosed() {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("diagnose-references");
-    if dir.exists() {
-        fs::remove_dir_all(&dir).unwrap();
-    }
+    let dir = fresh_dir("diagnose-references");
     fs::create_dir_all(&dir).unwrap();
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut rubric = "[defaults]\nthreshold = 8\npass_fraction = 0.01\npartial_fraction = 0.05\npass_flip = 0.1\npartial_flip = 0.2\n".to_owned();

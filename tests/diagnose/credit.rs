@@ -4,10 +4,7 @@ use super::*;
 
 #[test]
 fn a_rubric_can_grant_credit_per_mistake() {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("diagnose-credit");
-    if dir.exists() {
-        fs::remove_dir_all(&dir).unwrap();
-    }
+    let dir = fresh_dir("diagnose-credit");
     let plain = course_rubric(&dir);
     let rubric = load_rubric(&plain).unwrap();
     let renderers = renderers_for(&rubric, Perturbation::None);

@@ -270,12 +270,13 @@ struct AloneAndPacket<'a> {
 }
 
 impl Kernel for AloneAndPacket<'_> {
-    type Output = (Vec<LeafLog>, PacketLog);
+    /// Each ray's leaves alone, `(first, count)`, and the packet's.
+    type Output = (Vec<Vec<(u32, u32)>>, PacketLog);
     fn run<I: Isa>(self) -> Self::Output {
-        let mut alone = vec![LeafLog { calls: Vec::new(), stop_at: usize::MAX }; self.rays.len()];
-        for ((ray, log), &t_max) in self.rays.iter().zip(&mut alone).zip(&self.t_max) {
-            let mut limit_kept = VisitFn(|first, count, t_limit: &mut Real| {
-                log.calls.push((first, count, *t_limit));
+        let mut alone = vec![Vec::new(); self.rays.len()];
+        for ((ray, leaves), &t_max) in self.rays.iter().zip(&mut alone).zip(&self.t_max) {
+            let mut limit_kept = VisitFn(|first, count, _: &mut Real| {
+                leaves.push((first, count));
                 Visit::Continue
             });
             traverse::<I>(self.nodes, ray, t_max, &mut limit_kept);
@@ -323,10 +324,10 @@ fn a_packet_reaches_every_leaf_its_rays_reach_alone() {
         for rays in &packets {
             let (alone, packet) =
                 crate::simd::dispatch_on(path, AloneAndPacket { nodes: bvh.nodes(), rays, t_max }).unwrap();
-            let reached: usize = alone.iter().map(|alone| alone.calls.len()).sum();
+            let reached: usize = alone.iter().map(Vec::len).sum();
             assert!(reached > 2 * PACKET, "{path:?}: the rays reach {reached} leaves alone");
             for (lane, alone) in alone.iter().enumerate() {
-                for &(first, count, _) in &alone.calls {
+                for &(first, count) in alone {
                     assert!(
                         packet.0.contains(&(lane, first, count)),
                         "{path:?}: ray {lane} reaches leaf {first} alone, not in its packet"

@@ -8,8 +8,7 @@ use std::fmt::Write as _;
 use super::super::diagnosis::{Confidence, Diagnosis, UNEXPLAINED, Unfinished};
 use super::super::golden::GOLDEN_DIR;
 use super::super::report::{ClassReport, mistakes_of};
-use super::super::score::format_points;
-use super::super::score::{ImageResult, StudentResult, percent};
+use super::super::score::{ImageResult, StudentResult, format_points, percent};
 use super::escape;
 use crate::fault::Fault;
 
