@@ -48,7 +48,7 @@ pub(super) fn decide(
         .collect();
     order.extend(rest);
     let order = without_accusations(order, scores, rule);
-    let picture_of = |set: &FaultSet| -> Option<RgbImage> {
+    let picture_of = |set: &FaultSet| -> Option<Arc<RgbImage>> {
         let index = subject.picture;
         if let Some(candidate) = singles.iter().chain(expanded.iter().copied()).find(|c| c.set == *set) {
             return Some(candidate.pictures[index].clone());
@@ -58,7 +58,8 @@ pub(super) fn decide(
         }
         // A fitted gamma: quantised from the golden film.
         let picture = store.pictures()[index];
-        (set.render_part().is_empty()).then(|| picture_with_faults(store.golden_film(), picture, store.tonemap(), set))
+        (set.render_part().is_empty())
+            .then(|| Arc::new(picture_with_faults(store.golden_film(), picture, store.tonemap(), set)))
     };
     let tolerance = Tolerance {
         pixel: rule.threshold,
@@ -75,7 +76,7 @@ pub(super) fn decide(
         let Some(mistake) = picture_of(&scored.set) else {
             continue;
         };
-        let expected = Image::from_rgb8(mistake.clone(), scored.set.to_string());
+        let expected = Image::from_rgb8(RgbImage::clone(&mistake), scored.set.to_string());
         let Some(metrics) = compare(&expected, &student, &tolerance).metrics else {
             continue;
         };
@@ -138,7 +139,7 @@ pub(super) fn decide(
     if let Some(closest) = closest
         && let Some(mistake) = picture_of(&closest.set)
     {
-        let expected = Image::from_rgb8(mistake.clone(), closest.set.to_string());
+        let expected = Image::from_rgb8(RgbImage::clone(&mistake), closest.set.to_string());
         (mistake_image, residual_image) = write(&closest.set, &mistake, &expected);
     }
     Diagnosis {

@@ -78,7 +78,7 @@ pub(super) fn expansions(
         // prediction only chooses which pairs to render.
         let mut partners: Vec<(f64, FaultSet)> = singles
             .iter()
-            .filter(|b| b.set != a.set && b.pictures[subject.picture] != *subject.golden)
+            .filter(|b| b.set != a.set && *b.pictures[subject.picture] != *subject.golden)
             .filter_map(|b| {
                 let set = candidates::pair(&a.set, &b.set)?;
                 let predicted = predict(a_picture, &a.set, &b.pictures[subject.picture], &b.set, subject.golden);

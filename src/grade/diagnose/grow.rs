@@ -137,7 +137,7 @@ fn picture_of<'a>(
         .copied()
         .chain(grown)
         .find(|c| c.set == *set)
-        .map(|c| &c.pictures[index])
+        .map(|c| &*c.pictures[index])
 }
 
 /// Which pictures and thresholds the searches compare: the key of [`single_changes`].
@@ -255,7 +255,7 @@ fn step(
         };
         let picture = &candidate.pictures[subject.picture];
         let hidden = set.faults().any(|f| {
-            picture_of(&set.without(f), known, grown, subject.picture).is_some_and(|without| without == picture)
+            picture_of(&set.without(f), known, grown, subject.picture).is_some_and(|without| without == &**picture)
         });
         if !hidden
             && scored.residual.failing_fraction <= base.residual.failing_fraction

@@ -38,6 +38,11 @@ pub fn picture_name(picture: Picture) -> String {
     }
 }
 
+/// A fault set's pictures, in the order of [`FaultPictures::pictures`]. A picture many sets draw
+/// alike (most often the golden one) is one allocation shared by all of them: of course scene 7's
+/// 94 fault sets, 79 draw the golden normals, and a copy each was 150 MB of pages to fault in.
+pub type SetPictures = Arc<Vec<Arc<RgbImage>>>;
+
 /// Every picture a rubric takes from one render, for any fault set.
 pub struct FaultPictures<'a> {
     dir: Option<PathBuf>,
@@ -51,9 +56,12 @@ pub struct FaultPictures<'a> {
     /// Every picture the rubric takes from the render (a superset), written to the cache when a
     /// set is rendered, so that a later grading finds whichever it needs.
     stored: Vec<Picture>,
-    memo: Mutex<HashMap<String, Arc<Vec<RgbImage>>>>,
+    memo: Mutex<HashMap<String, SetPictures>>,
     /// Cache files decoded in this run, by file identity: one picture stored for many sets.
-    decoded: Mutex<HashMap<FileIdentity, RgbImage>>,
+    decoded: Mutex<HashMap<FileIdentity, Arc<RgbImage>>>,
+    /// The golden pictures, in the order of `pictures`: shared by every set that leaves one as
+    /// the golden draws it.
+    golden_pictures: Vec<Arc<RgbImage>>,
     /// The last films rendered, by render part, so that a render fault paired with PNG faults
     /// is quantised again rather than rendered again.
     films: Mutex<Vec<(String, Arc<Film>)>>,
@@ -74,6 +82,10 @@ impl<'a> FaultPictures<'a> {
         pictures: Vec<Picture>,
         stored: Vec<Picture>,
     ) -> Self {
+        let golden_pictures = pictures
+            .iter()
+            .map(|p| Arc::new(picture_with_faults(golden, *p, case.render.tonemap, &FaultSet::NONE)))
+            .collect();
         FaultPictures {
             dir,
             mode,
@@ -85,6 +97,7 @@ impl<'a> FaultPictures<'a> {
             memo: Mutex::new(HashMap::new()),
             decoded: Mutex::new(HashMap::new()),
             films: Mutex::new(Vec::new()),
+            golden_pictures,
             rendered: AtomicUsize::new(0),
             cached: AtomicUsize::new(0),
         }
@@ -95,15 +108,26 @@ impl<'a> FaultPictures<'a> {
     }
 
     /// The golden pictures, in the order of [`FaultPictures::pictures`].
-    pub fn golden(&self) -> Vec<RgbImage> {
-        self.quantise(self.golden, &FaultSet::NONE)
+    pub fn golden(&self) -> &[Arc<RgbImage>] {
+        &self.golden_pictures
     }
 
-    fn quantise(&self, film: &Film, faults: &FaultSet) -> Vec<RgbImage> {
+    /// The film's pictures with `faults`; each one equal to the golden picture is the golden's.
+    fn quantise(&self, film: &Film, faults: &FaultSet) -> Vec<Arc<RgbImage>> {
         self.pictures
             .iter()
-            .map(|p| picture_with_faults(film, *p, self.tonemap, faults))
+            .zip(&self.golden_pictures)
+            .map(|(p, golden)| self.shared(picture_with_faults(film, *p, self.tonemap, faults), golden))
             .collect()
+    }
+
+    /// `picture`, or `golden` when they are the same picture.
+    fn shared(&self, picture: RgbImage, golden: &Arc<RgbImage>) -> Arc<RgbImage> {
+        if picture == **golden {
+            golden.clone()
+        } else {
+            Arc::new(picture)
+        }
     }
 
     /// Every picture of the render quantised and written to the cache (best effort: a cache that
@@ -137,7 +161,7 @@ impl<'a> FaultPictures<'a> {
 
     /// The pictures a program with `faults` writes, in the order of [`FaultPictures::pictures`]:
     /// from this run's memory, the cache, the golden film (PNG faults only) or a render.
-    pub fn get(&self, faults: &FaultSet) -> Result<Arc<Vec<RgbImage>>, crate::Error> {
+    pub fn get(&self, faults: &FaultSet) -> Result<SetPictures, crate::Error> {
         let label = faults.to_string();
         if let Some(found) = self.lock().get(&label) {
             return Ok(found.clone());
@@ -175,7 +199,7 @@ impl<'a> FaultPictures<'a> {
     }
 
     /// The pictures of `faults` when some run already made them, without rendering.
-    pub fn get_if_known(&self, faults: &FaultSet) -> Option<Arc<Vec<RgbImage>>> {
+    pub fn get_if_known(&self, faults: &FaultSet) -> Option<SetPictures> {
         self.lock().get(&faults.to_string()).cloned()
     }
 
@@ -188,7 +212,7 @@ impl<'a> FaultPictures<'a> {
         self.tonemap
     }
 
-    fn lock(&self) -> std::sync::MutexGuard<'_, HashMap<String, Arc<Vec<RgbImage>>>> {
+    fn lock(&self) -> std::sync::MutexGuard<'_, HashMap<String, SetPictures>> {
         self.memo.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
     }
 
@@ -199,11 +223,12 @@ impl<'a> FaultPictures<'a> {
     /// Every picture of the set, or nothing: a partial or damaged entry is rendered again. A file
     /// that this run already decoded under another set's name (a link to the same content) is
     /// not decoded again.
-    fn read_cache(&self, label: &str) -> Option<Vec<RgbImage>> {
+    fn read_cache(&self, label: &str) -> Option<Vec<Arc<RgbImage>>> {
         let (width, height) = (self.golden.width, self.golden.height);
         self.pictures
             .iter()
-            .map(|p| {
+            .zip(&self.golden_pictures)
+            .map(|(p, golden)| {
                 let path = self.entry(label, *p)?;
                 let identity = file_identity(&path)?;
                 if let Some(known) = self.decoded_files().get(&identity) {
@@ -214,13 +239,14 @@ impl<'a> FaultPictures<'a> {
                 if picture.dimensions() != (width, height) {
                     return None;
                 }
+                let picture = self.shared(picture, golden);
                 self.decoded_files().insert(identity, picture.clone());
                 Some(picture)
             })
             .collect()
     }
 
-    fn decoded_files(&self) -> std::sync::MutexGuard<'_, HashMap<FileIdentity, RgbImage>> {
+    fn decoded_files(&self) -> std::sync::MutexGuard<'_, HashMap<FileIdentity, Arc<RgbImage>>> {
         self.decoded.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
     }
 }
