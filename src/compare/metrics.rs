@@ -192,7 +192,7 @@ pub(super) fn equal_rows(expected: &Image, actual: &Image) -> Vec<bool> {
                 .channels
                 .iter()
                 .zip(&actual.channels)
-                .all(|(e, a)| e.values.get(row.clone()) == a.values.get(row.clone()))
+                .all(|(e, a)| e.values.equal_in(&a.values, row.clone()))
         })
         .collect()
 }
@@ -228,12 +228,13 @@ pub(super) fn measure(
             worst: None,
         };
         let mut worst_error = 0.0_f64;
-        for (row, (e_row, a_row)) in e.values.chunks(width).zip(a.values.chunks(width)).enumerate() {
-            if skip_equal && equal_rows[row] {
+        for (row, (failing_row, &equal)) in failing.chunks_mut(width).zip(&equal_rows).enumerate() {
+            if skip_equal && equal {
                 continue;
             }
-            for (j, (&ev, &av)) in e_row.iter().zip(a_row).enumerate() {
+            for (j, failing) in failing_row.iter_mut().enumerate() {
                 let i = row * width + j;
+                let (ev, av) = (e.values[i], a.values[i]);
                 let at = || PixelError {
                     x: (i % width) as u32,
                     y: (i / width) as u32,
@@ -248,7 +249,7 @@ pub(super) fn measure(
                 };
                 if fails {
                     stats.failing += 1;
-                    failing[i] = true;
+                    *failing = true;
                 }
                 let error = match diff {
                     Difference::Finite(d) => d,

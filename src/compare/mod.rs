@@ -32,7 +32,7 @@ pub use comparison::{Comparison, compare, compare_timed, compare_widened};
 pub use error::CompareError;
 pub use files::{FileComparison, ToleranceOverrides, compare_files};
 pub use heatmap::{FAILING, NON_FINITE, comparison_heatmap, diff_heatmap, diff_heatmap_widened, evidence_heatmap};
-pub use image::{COLOR_CHANNELS, Channel, Encoding, Image};
+pub use image::{COLOR_CHANNELS, Channel, Encoding, Image, Plane};
 pub use metrics::{ChannelStats, Metrics, NonFinite, PixelError};
 pub use noise::{Evidence, Noise};
 pub use power::{POWER_PROBABILITY, POWER_WINDOW, Power};

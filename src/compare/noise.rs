@@ -39,7 +39,7 @@
 
 use serde::Serialize;
 
-use super::image::{COLOR_CHANNELS, Encoding, Image};
+use super::image::{COLOR_CHANNELS, Encoding, Image, Plane};
 use super::metrics::PixelError;
 use super::normal;
 use super::power::power;
@@ -160,8 +160,8 @@ pub fn sigma(expected: f32, actual: f32, var_expected: f32, var_actual: f32) -> 
 }
 
 /// The R, G and B planes of an image.
-fn colour_planes(image: &Image) -> Option<[&[f32]; 3]> {
-    let plane = |name: &str| image.channels.iter().find(|c| c.name == name).map(|c| &c.values[..]);
+fn colour_planes(image: &Image) -> Option<[&Plane; 3]> {
+    let plane = |name: &str| image.channels.iter().find(|c| c.name == name).map(|c| &c.values);
     Some([plane("R")?, plane("G")?, plane("B")?])
 }
 

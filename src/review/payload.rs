@@ -27,7 +27,7 @@ pub fn case_script(review: &CaseReview) -> String {
     for (side, image) in sides {
         let Some(image) = image else { continue };
         for channel in &image.channels {
-            plane(format!("{side}.{}", channel.name), &mut channel.values.iter().copied());
+            plane(format!("{side}.{}", channel.name), &mut channel.values.iter());
         }
         if let Some(variance) = &image.variance {
             for (c, name) in ["R", "G", "B"].iter().enumerate() {
