@@ -9,7 +9,7 @@ use serde::Serialize;
 
 use super::png::{color_image, depth_image, normals_image, quantised_image};
 use super::{Film, Tonemap};
-use crate::fault::{Fault, FaultSet, Gamma, Mapping};
+use crate::fault::{Fault, FaultSet, Gamma, Mapping, Pictures};
 
 /// Which of the course binary's pictures.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -22,6 +22,17 @@ pub enum Picture {
         min: f32,
         max: f32,
     },
+}
+
+impl Picture {
+    /// Whether a fault that can change `pictures` can change this one.
+    pub fn among(self, pictures: Pictures) -> bool {
+        match self {
+            Picture::Color => pictures.color,
+            Picture::Normals => pictures.normals,
+            Picture::Depth { .. } => pictures.depth,
+        }
+    }
 }
 
 /// `picture` of `film` as a program with the output faults of `faults` writes it (the other

@@ -14,11 +14,7 @@ pub fn singles(case: &Case, pictures: &[Picture]) -> Vec<FaultSet> {
     let mut sets = Vec::new();
     for fault in Fault::ALL {
         let can = fault.pictures();
-        let shows = pictures.iter().any(|p| match p {
-            Picture::Color => can.color,
-            Picture::Normals => can.normals,
-            Picture::Depth { .. } => can.depth,
-        });
+        let shows = pictures.iter().any(|p| p.among(can));
         if !shows || !fault_applies(case, fault) {
             continue;
         }
