@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 
 use serde::{Deserialize, Deserializer, Serialize};
 
-use super::image::{COLOR_CHANNELS, Channel, Encoding, Image};
+use super::image::{COLOR_CHANNELS, Channel, Encoding, Image, Plane};
 
 /// One channel of one pixel in both images.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -228,47 +228,64 @@ pub(super) fn measure(
             worst: None,
         };
         let mut worst_error = 0.0_f64;
-        for (row, (failing_row, &equal)) in failing.chunks_mut(width).zip(&equal_rows).enumerate() {
+        let mut measure_value = |i: usize, ev: f32, av: f32| {
+            let at = || PixelError {
+                x: (i % width) as u32,
+                y: (i / width) as u32,
+                channel: e.name,
+                expected: ev,
+                actual: av,
+            };
+            let diff = difference(ev, av, e.infinity_is_a_value());
+            let fails = match color_index {
+                Some(c) => colour.fails(diff, pixel_threshold, i, c),
+                None => diff.exceeds(pixel_threshold),
+            };
+            if fails {
+                stats.failing += 1;
+                failing[i] = true;
+            }
+            let error = match diff {
+                Difference::Finite(d) => d,
+                Difference::Coverage => f64::INFINITY,
+                Difference::Broken => {
+                    match &mut non_finite {
+                        Some(found) => found.count += 1,
+                        None => non_finite = Some(NonFinite { count: 1, first: at() }),
+                    }
+                    return;
+                }
+            };
+            if is_color {
+                sum_abs += error;
+                sum_sq += error * error;
+            }
+            if error > worst_error {
+                worst_error = error;
+                stats.worst = Some(at());
+            }
+        };
+        for (row, &equal) in equal_rows.iter().enumerate() {
             if skip_equal && equal {
                 continue;
             }
-            for (j, failing) in failing_row.iter_mut().enumerate() {
-                let i = row * width + j;
-                let (ev, av) = (e.values[i], a.values[i]);
-                let at = || PixelError {
-                    x: (i % width) as u32,
-                    y: (i / width) as u32,
-                    channel: e.name,
-                    expected: ev,
-                    actual: av,
-                };
-                let diff = difference(ev, av, e.infinity_is_a_value());
-                let fails = match color_index {
-                    Some(c) => colour.fails(diff, pixel_threshold, i, c),
-                    None => diff.exceeds(pixel_threshold),
-                };
-                if fails {
-                    stats.failing += 1;
-                    *failing = true;
-                }
-                let error = match diff {
-                    Difference::Finite(d) => d,
-                    Difference::Coverage => f64::INFINITY,
-                    Difference::Broken => {
-                        match &mut non_finite {
-                            Some(found) => found.count += 1,
-                            None => non_finite = Some(NonFinite { count: 1, first: at() }),
+            let row = row * width..(row + 1) * width;
+            match (&e.values, &a.values) {
+                // Most values of a differing row are equal too: bytes are compared as bytes.
+                (Plane::Code8(e), Plane::Code8(a)) if skip_equal => {
+                    for ((i, &ev), &av) in row.clone().zip(&e[row.clone()]).zip(&a[row]) {
+                        if ev != av {
+                            measure_value(i, f32::from(ev), f32::from(av));
                         }
-                        continue;
                     }
-                };
-                if is_color {
-                    sum_abs += error;
-                    sum_sq += error * error;
                 }
-                if error > worst_error {
-                    worst_error = error;
-                    stats.worst = Some(at());
+                _ => {
+                    for i in row {
+                        let (ev, av) = (e.values[i], a.values[i]);
+                        if !(skip_equal && ev == av) {
+                            measure_value(i, ev, av);
+                        }
+                    }
                 }
             }
         }
@@ -350,4 +367,35 @@ pub(super) fn same_layout(expected: &Image, actual: &Image) -> bool {
         && expected.channel_names() == actual.channel_names()
         && complete(expected)
         && complete(actual)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rgb_image::{Rgb, RgbImage};
+
+    /// The same values as floats, so that the byte path is checked against the float one.
+    fn as_floats(image: &Image) -> Image {
+        let mut floats = image.clone();
+        for channel in &mut floats.channels {
+            channel.values = Plane::Linear(channel.values.iter().collect());
+        }
+        floats
+    }
+
+    #[test]
+    fn bytes_measure_as_their_floats_do() {
+        let golden = RgbImage::from_fn(37, 9, |x, y| Rgb([(x * 6) as u8, (y * 20) as u8, 128]));
+        let mut student = golden.clone();
+        for (x, y, by) in [(0, 0, 3), (5, 1, 40), (36, 8, 200), (17, 4, 9)] {
+            let Rgb([r, g, b]) = *golden.get_pixel(x, y);
+            student.put_pixel(x, y, Rgb([r.wrapping_add(by), g, b.wrapping_sub(by / 2)]));
+        }
+        let (expected, actual) = (Image::from_rgb8(golden, "g.png"), Image::from_rgb8(student, "s.png"));
+        let (bytes, _) = measure(&expected, &actual, 8.0, ColourRule::Threshold);
+        let (floats, _) = measure(&as_floats(&expected), &as_floats(&actual), 8.0, ColourRule::Threshold);
+        assert_eq!(bytes, floats);
+        assert_eq!(bytes.failing_pixels, 3, "the change of 3 codes is within the threshold");
+        assert_eq!(bytes.worst.map(|w| (w.x, w.y)), Some((36, 8)));
+    }
 }
