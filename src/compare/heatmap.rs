@@ -15,7 +15,7 @@
 use crate::rgb_image::{Rgb, RgbImage};
 
 use super::comparison::Comparison;
-use super::image::{COLOR_CHANNELS, Image};
+use super::image::{COLOR_CHANNELS, Encoding, Image};
 use super::metrics::{ColourRule, Difference, difference};
 use super::noise::{self, Noise};
 
@@ -58,14 +58,29 @@ fn heatmap_with(expected: &Image, actual: &Image, pixel_threshold: f64, colour: 
         .collect();
     let mut heatmap = RgbImage::from_fn(expected.width, expected.height, |x, y| backdrop(expected, x, y));
     let equal_rows = super::metrics::equal_rows(expected, actual);
+    // A pixel equal in every channel is backdrop (a zero difference fails no threshold that is
+    // not negative): whole rows of it are most rows of a graded picture, and most pixels of the
+    // others. 8-bit pictures hold their values as the preview's bytes.
+    let skip_equal = pixel_threshold >= 0.0;
+    let bytes = (expected.encoding == Encoding::Code8 && actual.encoding == Encoding::Code8)
+        .then(|| (expected.preview.as_raw(), actual.preview.as_raw()));
+    let equal_pixel = |i: usize| match bytes {
+        Some((e, a)) => e[3 * i..3 * i + 3] == a[3 * i..3 * i + 3],
+        None => expected
+            .channels
+            .iter()
+            .zip(&actual.channels)
+            .all(|(e, a)| e.values[i] == a.values[i]),
+    };
     for y in 0..expected.height {
-        // A row equal in every channel is all backdrop (a zero difference fails no threshold
-        // that is not negative): most rows of a graded picture.
-        if pixel_threshold >= 0.0 && equal_rows[y as usize] {
+        if skip_equal && equal_rows[y as usize] {
             continue;
         }
         for x in 0..expected.width {
             let i = y as usize * width + x as usize;
+            if skip_equal && equal_pixel(i) {
+                continue;
+            }
             let mut largest = 0.0_f64;
             let mut failing = false;
             let mut broken = false;
