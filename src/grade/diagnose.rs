@@ -48,9 +48,10 @@ use crate::rgb_image::RgbImage;
 use super::diagnosis::{
     Closest, Confidence, Diagnosis, DiagnosisRun, RenderDiagnosis, Residual, UNEXPLAINED, Unfinished, UnfinishedPart,
 };
+use super::judge::judge;
 use super::outcome::Outcome;
 use super::rubric::{ImageSpec, Rubric, Rule};
-use super::score::{ImageResult, StudentResult, judge};
+use super::score::{ImageResult, StudentResult};
 use crate::atomic_write::replace_file;
 use crate::compare::{Image, Tolerance, compare, diff_heatmap};
 use crate::fault::{Fault, FaultSet, Gamma, Parameter};

@@ -4,7 +4,8 @@
 //! `results.json`), so a student reads the same sentence wherever they are graded.
 
 use super::diagnosis::{Confidence, UNEXPLAINED};
-use super::score::{ImageResult, StudentResult, format_points};
+use super::judge::format_points;
+use super::score::{ImageResult, StudentResult};
 
 /// How many of the last lines of a failing command's stderr the feedback quotes: enough for a
 /// compiler's first errors in a short build log.

@@ -14,9 +14,10 @@ mod mistakes;
 mod program;
 
 use super::golden::GOLDEN_DIR;
+use super::judge::{format_points, percent};
 use super::outcome::Outcome;
 use super::report::{ClassReport, flags};
-use super::score::{ImageResult, StudentResult, format_points, percent};
+use super::score::{ImageResult, StudentResult};
 use crate::atomic_write::{replace_file, write_file_atomic};
 use crate::compare::Metrics;
 use crate::film::OutputError;

@@ -35,7 +35,7 @@ pub(in crate::grade) fn apply_credit(rubric: &Rubric, students: &mut [StudentRes
                 diagnosis.credit = Some(credit);
                 image.explanation.push_str(&format!(
                     "; the rubric grants {} of the points for the diagnosed mistake {}",
-                    super::super::score::percent(credit),
+                    super::super::judge::percent(credit),
                     diagnosis.id
                 ));
             }

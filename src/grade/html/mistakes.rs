@@ -7,8 +7,9 @@ use std::fmt::Write as _;
 
 use super::super::diagnosis::{Confidence, Diagnosis, UNEXPLAINED, Unfinished};
 use super::super::golden::GOLDEN_DIR;
+use super::super::judge::{format_points, percent};
 use super::super::report::{ClassReport, mistakes_of};
-use super::super::score::{ImageResult, StudentResult, format_points, percent};
+use super::super::score::{ImageResult, StudentResult};
 use super::escape;
 use crate::fault::Fault;
 
