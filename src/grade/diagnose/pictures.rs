@@ -124,19 +124,10 @@ impl<'a> FaultPictures<'a> {
                 if golden_film && !p.among(faults.pictures()) {
                     golden.clone()
                 } else {
-                    self.shared(picture_with_faults(film, *p, self.tonemap, faults), golden)
+                    shared(picture_with_faults(film, *p, self.tonemap, faults), golden)
                 }
             })
             .collect()
-    }
-
-    /// `picture`, or `golden` when they are the same picture.
-    fn shared(&self, picture: RgbImage, golden: &Arc<RgbImage>) -> Arc<RgbImage> {
-        if picture == **golden {
-            golden.clone()
-        } else {
-            Arc::new(picture)
-        }
     }
 
     /// Every picture of the render quantised and written to the cache (best effort: a cache that
@@ -248,7 +239,7 @@ impl<'a> FaultPictures<'a> {
                 if picture.dimensions() != (width, height) {
                     return None;
                 }
-                let picture = self.shared(picture, golden);
+                let picture = shared(picture, golden);
                 self.decoded_files().insert(identity, picture.clone());
                 Some(picture)
             })
@@ -257,6 +248,15 @@ impl<'a> FaultPictures<'a> {
 
     fn decoded_files(&self) -> std::sync::MutexGuard<'_, HashMap<FileIdentity, Arc<RgbImage>>> {
         self.decoded.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
+}
+
+/// `picture`, or `golden` when they are the same picture.
+fn shared(picture: RgbImage, golden: &Arc<RgbImage>) -> Arc<RgbImage> {
+    if picture == **golden {
+        golden.clone()
+    } else {
+        Arc::new(picture)
     }
 }
 
