@@ -161,8 +161,11 @@ fn agreement(precision: Precision, spawn: Spawn, placements: &[(String, Placemen
                 fraction * 100.0
             );
             if fraction < 0.999 {
-                let name = format!("goldray-scale-{}-{spawn:?}-{label}.png", precision.name()).replace(' ', "_");
-                goldray::film::write_png(&std::env::temp_dir().join(name), &image).unwrap();
+                // Kept to look at, inside the build's own folder rather than the system's.
+                let name = format!("{}-{spawn:?}-{label}.png", precision.name()).replace(' ', "_");
+                let kept = Path::new(env!("CARGO_TARGET_TMPDIR")).join("scale-invariance");
+                std::fs::create_dir_all(&kept).unwrap();
+                goldray::film::write_png(&kept.join(name), &image).unwrap();
             }
             (label.clone(), fraction)
         })
