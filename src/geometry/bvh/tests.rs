@@ -210,13 +210,21 @@ impl Kernel for BothWays<'_> {
     }
 }
 
-#[test]
-fn interleaved_rays_each_visit_what_they_visit_alone() {
+/// 3,000 boxes of side 3 spread over a 101×53×29 block, overlapping one another, so that a ray
+/// through the block reaches many leaves: the traversal tests' scene, as each box's lowest
+/// corner and the tree.
+fn overlapping_boxes() -> (Vec<Vec3>, Bvh) {
     let points: Vec<Vec3> = (0..3000)
         .map(|i| Vec3::new((i * 37 % 101) as Real, (i * 11 % 53) as Real, (i * 7 % 29) as Real))
         .collect();
     let boxes: Vec<Aabb> = points.iter().map(|&p| Aabb::new(p, p + Vec3::splat(3.0))).collect();
     let bvh = Bvh::build(&boxes);
+    (points, bvh)
+}
+
+#[test]
+fn interleaved_rays_each_visit_what_they_visit_alone() {
+    let (_, bvh) = overlapping_boxes();
     // Rays from all over, in every direction, one starting inside, one along an axis, one
     // not finite (which visits nothing), and one whose limit ends before the boxes start.
     let mut rays: Vec<Ray> = (0..7)
@@ -291,11 +299,7 @@ impl Kernel for AloneAndPacket<'_> {
 
 #[test]
 fn a_packet_reaches_every_leaf_its_rays_reach_alone() {
-    let points: Vec<Vec3> = (0..3000)
-        .map(|i| Vec3::new((i * 37 % 101) as Real, (i * 11 % 53) as Real, (i * 7 % 29) as Real))
-        .collect();
-    let boxes: Vec<Aabb> = points.iter().map(|&p| Aabb::new(p, p + Vec3::splat(3.0))).collect();
-    let bvh = Bvh::build(&boxes);
+    let (points, bvh) = overlapping_boxes();
     // Tiles of camera rays from one point, among them one from exactly a box's corner and one
     // whose rays start inside the boxes; then rays from eight points and a tile with a direction
     // component of zero.
