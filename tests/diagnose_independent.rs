@@ -329,7 +329,7 @@ fn the_starters_page_shows_one_unfinished_finding() {
     let graded = graded();
     let page = graded.dir.join("report").join(&student(graded, "starter").page);
     let dom = chromium::dump_dom(&page);
-    assert!(dom.contains("data-images-broken=\"0\""), "a picture did not load");
+    chromium::assert_pictures_loaded(&dom, "the starter's page");
     let findings = dom.matches("<section class=\"mistake").count();
     assert_eq!(findings, 1, "one finding on the page:\n{dom}");
     assert!(dom.contains("data-mistake=\"unfinished\""));

@@ -79,6 +79,15 @@ pub fn dump_dom(page: &Path) -> String {
     String::from_utf8(stdout).expect("the DOM is UTF-8")
 }
 
+/// Fails, naming `page`, unless every picture of the page loaded: the reports count the pictures
+/// that loaded and broke (`data-images-broken`) in their load handlers.
+pub fn assert_pictures_loaded(dom: &str, page: &str) {
+    assert!(
+        dom.contains("data-images-broken=\"0\""),
+        "{page}: a picture did not load:\n{dom}"
+    );
+}
+
 /// [`dump_dom`] in a `width`×`height` window, for what depends on layout.
 pub fn dump_dom_at(page: &Path, width: u32, height: u32) -> String {
     let stdout = run(
