@@ -157,11 +157,12 @@ fn render_pixels<C: RayCounter, F: FaultPolicy, M: Moments>(
                     }
                 }
                 None => {
+                    let mut scratch = Samples::default();
                     for offset in 0..pixel_count {
                         let index = first + offset;
                         let (x, y) = ((index % width) as u32, (index / width) as u32);
                         let mut rays = RayCounts::default();
-                        let pixel = pixels.pixel::<M>(x, y, &mut rays);
+                        let pixel = pixels.pixel::<M>(x, y, &mut rays, &mut scratch);
                         counter.add(&rays);
                         store(offset, pixel);
                     }
@@ -179,6 +180,14 @@ fn render_pixels<C: RayCounter, F: FaultPolicy, M: Moments>(
     }
     film.variance = M::assemble(variances);
     (film, counter)
+}
+
+/// A pixel's sample points and the colours seen through them, kept from pixel to pixel so that
+/// no pixel allocates.
+#[derive(Default)]
+struct Samples {
+    points: Vec<Vec2>,
+    colors: Vec<Color>,
 }
 
 struct Pixel<M> {
@@ -207,8 +216,8 @@ impl<F: FaultPolicy> PixelRenderer<'_, F> {
     }
 
     /// The pixel's colour (with its moments `M`) and AOVs; every ray traced for it is added to
-    /// `rays`.
-    fn pixel<M: Moments>(&self, x: u32, y: u32, rays: &mut RayCounts) -> Pixel<M> {
+    /// `rays`. `scratch` holds its samples on the way.
+    fn pixel<M: Moments>(&self, x: u32, y: u32, rays: &mut RayCounts, scratch: &mut Samples) -> Pixel<M> {
         let (width, height) = (self.options.trace.width, self.options.trace.height);
         let centre = pixel_centre(x, y);
         let subpixels: &[(u32, u32, Real)] = match self.options.trace.filter {
@@ -223,68 +232,47 @@ impl<F: FaultPolicy> PixelRenderer<'_, F> {
             Filter::Gaussian => &GAUSSIAN_SUBPIXELS,
         };
         let scale = if self.options.trace.filter == Filter::Gaussian { 3 } else { 1 };
-        let mut color = M::zero();
-        let count = self.sampler.samples_per_pixel();
-        let mut moments = M::Accumulator::default();
-        let size = (scale * width, scale * height);
+        let count = self.sampler.samples_per_pixel() as usize;
         // The samples in order: sub-pixel by sub-pixel, each sub-pixel's `count` samples.
-        let (mut made, mut pixel, mut sub_origin) = (0, self.sampler.pixel(0, 0), Vec2::ZERO);
-        let (mut taken, mut sub) = (0, 0);
-        self.trace_samples(subpixels.len() as u32 * count, size, rays, #[inline(always)] || {
-            if made % count == 0 {
-                let (i, j, _) = subpixels[(made / count) as usize];
-                let (sx, sy) = (scale * x + i, scale * y + j);
-                (pixel, sub_origin) = (self.sampler.pixel(sx, sy), Vec2::new(sx as Real, sy as Real));
+        scratch.points.clear();
+        for &(i, j, _) in subpixels {
+            let (sx, sy) = (scale * x + i, scale * y + j);
+            self.sampler.pixel(sx, sy).push_points(Vec2::new(sx as Real, sy as Real), &mut scratch.points);
+        }
+        self.trace_points(&scratch.points, (scale * width, scale * height), rays, &mut scratch.colors);
+        let mut color = M::zero();
+        for (colors, &(_, _, weight)) in scratch.colors.chunks_exact(count).zip(subpixels) {
+            let mut moments = M::Accumulator::default();
+            for &sample in colors {
+                M::push(&mut moments, sample);
             }
-            made += 1;
-            sub_origin + pixel.offset((made - 1) % count)
-        }, #[inline(always)] |sample| {
-            M::push(&mut moments, sample);
-            taken += 1;
-            if taken == count {
-                let finished = M::of(std::mem::take(&mut moments), count);
-                if scale == 1 {
-                    color = finished;
-                } else {
-                    color.add_weighted(&finished, subpixels[sub].2);
-                }
-                (taken, sub) = (0, sub + 1);
+            let finished = M::of(moments, count as u32);
+            if scale == 1 {
+                color = finished;
+            } else {
+                color.add_weighted(&finished, weight);
             }
-        });
+        }
         let first = self.first_hit(centre, rays).map(|hit| (hit.surface.t, hit.surface.shading_normal));
         Pixel::new(color, first)
     }
 
-    /// Traces `total` camera rays through the points `raster()` returns one after another, on
-    /// the raster of an image of `size`, and hands each one's colour to `sample(colour)` in the
-    /// same order: eight at a time when the eight-lane integrator can draw them, one at a time
-    /// otherwise.
-    fn trace_samples(
-        &self,
-        total: u32,
-        (width, height): (u32, u32),
-        rays: &mut RayCounts,
-        mut raster: impl FnMut() -> Vec2,
-        mut sample: impl FnMut(Color),
-    ) {
-        rays.camera += u64::from(total);
+    /// The colours seen along the camera rays through `points`, on the raster of an image of
+    /// `size`, in place of `colors`' contents and in the same order: eight at a time when the
+    /// eight-lane integrator can draw them, one at a time otherwise.
+    fn trace_points(&self, points: &[Vec2], (width, height): (u32, u32), rays: &mut RayCounts, colors: &mut Vec<Color>) {
+        rays.camera += points.len() as u64;
+        colors.clear();
         let Some(lanes) = &self.lanes else {
-            for _ in 0..total {
-                let ray = self.scene.camera.ray(raster(), width, height);
-                sample(self.integrator.trace(ray, rays).0);
+            for &point in points {
+                let ray = self.scene.camera.ray(point, width, height);
+                colors.push(self.integrator.trace(ray, rays).0);
             }
             return;
         };
-        let mut points = [Vec2::ZERO; LANES];
-        for start in (0..total).step_by(LANES) {
-            let count = (total - start).min(LANES as u32) as usize;
-            for point in &mut points[..count] {
-                *point = raster();
-            }
-            let traced = lanes.trace(&points[..count], (width, height), false, rays);
-            for color in &traced.color[..count] {
-                sample(*color);
-            }
+        for batch in points.chunks(LANES) {
+            let traced = lanes.trace(batch, (width, height), false, rays);
+            colors.extend_from_slice(&traced.color[..batch.len()]);
         }
     }
 

@@ -52,23 +52,34 @@ pub struct PixelSamples {
 }
 
 impl PixelSamples {
-    /// Position of sample `index` inside the pixel, in `[0, 1)²`: a uniformly jittered point in
-    /// stratum `(index mod n, index div n)`. Always inlined: called once per sample, it costs
-    /// a sampled render 19% when the compiler leaves it out of line (docs/statistical-verdict.md).
+    /// Appends the positions of the pixel's samples, each moved by `origin` (the pixel's corner
+    /// on the raster), to `points`, in index order: sample `index` is a uniformly jittered point
+    /// in stratum `(index mod n, index div n)`. The strata are walked row by row, so that no
+    /// sample pays for a division to find its own. Always inlined: it runs once per pixel, but
+    /// its body once per sample.
     #[inline(always)]
-    pub fn offset(&self, index: u32) -> Vec2 {
+    pub fn push_points(&self, origin: Vec2, points: &mut Vec<Vec2>) {
         let strata = self.sampler.strata;
         if strata == 1 {
-            return Vec2::splat(0.5);
+            points.push(origin + Vec2::splat(0.5));
+            return;
         }
         if self.sampler.seeding == Seeding::PixelIndex {
-            return pixel_seeded(self.x, self.y);
+            let point = origin + pixel_seeded(self.x, self.y);
+            points.extend(std::iter::repeat_n(point, (strata * strata) as usize));
+            return;
         }
         let n = strata as Real;
-        let hash = mix(self.hash, index as u64);
-        let stratum = Vec2::new((index % strata) as Real, (index / strata) as Real);
-        let jitter = Vec2::new(unit_interval(hash), unit_interval(mix(hash, 0x5bd1_e995)));
-        (stratum + jitter) / n
+        let mut index = 0;
+        for row in 0..strata {
+            for column in 0..strata {
+                let hash = mix(self.hash, index);
+                index += 1;
+                let stratum = Vec2::new(column as Real, row as Real);
+                let jitter = Vec2::new(unit_interval(hash), unit_interval(mix(hash, 0x5bd1_e995)));
+                points.push(origin + (stratum + jitter) / n);
+            }
+        }
     }
 }
 
@@ -99,17 +110,35 @@ fn unit_interval(bits: u64) -> Real {
 mod tests {
     use super::*;
 
+    /// The sample positions of pixel `(x, y)` inside it.
+    fn offsets(sampler: Sampler, x: u32, y: u32) -> Vec<Vec2> {
+        let mut points = Vec::new();
+        sampler.pixel(x, y).push_points(Vec2::ZERO, &mut points);
+        points
+    }
+
     #[test]
     fn one_sample_is_the_centre() {
-        let s = Sampler::new(1, 7);
-        assert_eq!(s.pixel(3, 4).offset(0), Vec2::splat(0.5));
+        assert_eq!(offsets(Sampler::new(1, 7), 3, 4), [Vec2::splat(0.5)]);
+    }
+
+    #[test]
+    fn points_are_the_offsets_moved_to_the_pixel() {
+        let s = Sampler::new(9, 5);
+        let mut points = Vec::new();
+        s.pixel(2, 3).push_points(Vec2::new(2.0, 3.0), &mut points);
+        let moved: Vec<Vec2> = offsets(s, 2, 3).iter().map(|offset| Vec2::new(2.0, 3.0) + *offset).collect();
+        assert_eq!(points, moved);
+        let fixed = Sampler::with_seeding(4, 5, Seeding::PixelIndex);
+        assert_eq!(offsets(fixed, 2, 3), [offsets(fixed, 2, 3)[0]; 4]);
     }
 
     #[test]
     fn each_sample_stays_in_its_stratum() {
         let s = Sampler::new(16, 42);
-        for index in 0..16 {
-            let p = s.pixel(10, 20).offset(index);
+        let points = offsets(s, 10, 20);
+        assert_eq!(points.len(), 16);
+        for (index, p) in (0..16).zip(points) {
             let (sx, sy) = ((index % 4) as Real, (index / 4) as Real);
             assert!(p.x >= sx / 4.0 && p.x < (sx + 1.0) / 4.0);
             assert!(p.y >= sy / 4.0 && p.y < (sy + 1.0) / 4.0);
@@ -119,15 +148,16 @@ mod tests {
     #[test]
     fn samples_depend_on_seed_pixel_and_index_only() {
         let a = Sampler::new(4, 1);
-        assert_eq!(a.pixel(5, 6).offset(2), Sampler::new(4, 1).pixel(5, 6).offset(2));
-        assert_ne!(a.pixel(5, 6).offset(2), Sampler::new(4, 2).pixel(5, 6).offset(2));
-        assert_ne!(a.pixel(5, 6).offset(2), a.pixel(6, 5).offset(2));
+        let third = |sampler, x, y| offsets(sampler, x, y)[2];
+        assert_eq!(third(a, 5, 6), third(Sampler::new(4, 1), 5, 6));
+        assert_ne!(third(a, 5, 6), third(Sampler::new(4, 2), 5, 6));
+        assert_ne!(third(a, 5, 6), third(a, 6, 5));
     }
 
     #[test]
     fn jitter_is_roughly_uniform() {
         let s = Sampler::new(4, 3);
-        let mean: Real = (0..10_000u32).map(|i| s.pixel(i, i / 7).offset(0).x * 2.0).sum::<Real>() / 10_000.0;
+        let mean: Real = (0..10_000u32).map(|i| offsets(s, i, i / 7)[0].x * 2.0).sum::<Real>() / 10_000.0;
         assert!((mean - 0.5).abs() < 0.02, "{mean}");
     }
 }
