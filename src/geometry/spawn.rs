@@ -80,18 +80,8 @@ fn spawn_offset_lanes<I: Isa>(hit: &SurfaceLanes<I>, direction: V3<I>) -> V3<I> 
     let distance = normal.abs().dot(hit.point_error);
     let offset = normal.scale(distance);
     let offset = V3::select(direction.dot(normal).lt(R8::<I>::splat(0.0)), -offset, offset);
-    let mut origin = (hit.point + offset).store();
-    let offset = offset.store();
-    for (origin, offset) in origin.iter_mut().zip(&offset) {
-        for (origin, &offset) in origin.iter_mut().zip(offset) {
-            if offset > 0.0 {
-                *origin = origin.next_up();
-            } else if offset < 0.0 {
-                *origin = origin.next_down();
-            }
-        }
-    }
-    V3::load(&origin)
+    let origin = hit.point + offset;
+    V3 { x: origin.x.step_towards(offset.x), y: origin.y.step_towards(offset.y), z: origin.z.step_towards(offset.z) }
 }
 
 /// [`spawn`] for a hit and a direction per lane.

@@ -219,7 +219,7 @@ pub trait Isa: Copy + 'static {
 pub trait Lanes:
     Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self> + Neg<Output = Self>
 {
-    type Elem: Copy;
+    type Elem: Copy + From<f32>;
     type Mask: MaskOps;
     const N: usize;
     fn splat(value: Self::Elem) -> Self;
@@ -240,6 +240,27 @@ pub trait Lanes:
     fn is_nan(self) -> Self::Mask;
     /// `mask ? if_true : if_false` per lane.
     fn select(mask: Self::Mask, if_true: Self, if_false: Self) -> Self;
+    /// Each lane's bit pattern, read as an integer, plus one where `increment` is set and minus
+    /// one where `decrement` is set (never both): for a finite lane other than zero, the next
+    /// float away from zero and the next towards it.
+    fn adjust_bits(self, increment: Self::Mask, decrement: Self::Mask) -> Self;
+
+    /// Each lane moved to the next float towards +∞ where `direction` is positive and towards
+    /// −∞ where it is negative, lane by lane exactly `next_up` and `next_down` (an infinity
+    /// already there and a NaN stay as they are); left alone where `direction` is zero or NaN.
+    #[inline(always)]
+    fn step_towards(self, direction: Self) -> Self {
+        let zero = Self::splat(0.0.into());
+        let (up, down) = (direction.gt(zero), direction.lt(zero));
+        let (positive, negative, is_zero) = (self.gt(zero), self.lt(zero), self.eq(zero));
+        let finite = self.abs().lt(Self::splat(f32::INFINITY.into()));
+        // A zero that moves steps from the zero of its side: ±0's bits plus one are ±tiny's.
+        let leaving_zero = is_zero.and(up.or(down));
+        let start = Self::select(leaving_zero, Self::select(down, Self::splat((-0.0).into()), zero), self);
+        let away = positive.and(up).or(negative.and(down)).and(finite).or(leaving_zero);
+        let towards_zero = positive.and(down).or(negative.and(up));
+        start.adjust_bits(away, towards_zero)
+    }
 }
 
 /// A true/false flag per lane, the result of comparing [`Lanes`].
@@ -301,6 +322,103 @@ mod tests {
             for result in results.into_iter().flatten() {
                 assert_eq!(format!("{result:?}"), format!("{portable:?}"));
             }
+        }
+    }
+
+    /// Every pair of a value and a direction that `step_towards` treats apart, as `f32`.
+    fn stepping_cases() -> Vec<(f32, f32)> {
+        let tiny = f32::from_bits(1);
+        let values = [
+            0.0,
+            -0.0,
+            tiny,
+            -tiny,
+            1.0,
+            -1.0,
+            0.75,
+            -3.5e7,
+            1.0e-40,
+            f32::MIN_POSITIVE,
+            f32::MAX,
+            -f32::MAX,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+        ];
+        let directions = [1.0, -1.0, 0.0, -0.0, 1.0e-30, f32::NEG_INFINITY, f32::NAN];
+        values
+            .iter()
+            .flat_map(|&v| directions.iter().map(move |&d| (v, d)))
+            .collect()
+    }
+
+    /// What `next_up` and `next_down` make of `value` for `direction`, as bits.
+    fn stepped_alone<T: Into<f64> + Copy>(value: T, direction: T, up: fn(T) -> T, down: fn(T) -> T) -> T {
+        let d: f64 = direction.into();
+        if d > 0.0 {
+            up(value)
+        } else if d < 0.0 {
+            down(value)
+        } else {
+            value
+        }
+    }
+
+    struct Stepping(Vec<(f32, f32)>);
+
+    impl Kernel for Stepping {
+        type Output = (Vec<u32>, Vec<u32>, Vec<u64>, Vec<u64>);
+        #[inline(always)]
+        fn run<I: Isa>(self) -> Self::Output {
+            fn each<L: Lanes>(cases: &[(f32, f32)], width: usize) -> Vec<L::Elem>
+            where
+                L::Elem: Default,
+            {
+                let mut out = Vec::new();
+                for chunk in cases.chunks(width) {
+                    let (mut values, mut directions) =
+                        (vec![L::Elem::default(); width], vec![L::Elem::default(); width]);
+                    for (k, &(v, d)) in chunk.iter().enumerate() {
+                        (values[k], directions[k]) = (v.into(), d.into());
+                    }
+                    let mut stepped = vec![L::Elem::default(); width];
+                    L::load(&values).step_towards(L::load(&directions)).store(&mut stepped);
+                    out.extend_from_slice(&stepped[..chunk.len()]);
+                }
+                out
+            }
+            let cases = &self.0;
+            (
+                each::<I::F32x8>(cases, 8).into_iter().map(f32::to_bits).collect(),
+                each::<I::F32x4>(cases, 4).into_iter().map(f32::to_bits).collect(),
+                each::<I::F64x8>(cases, 8).into_iter().map(f64::to_bits).collect(),
+                each::<I::F64x4>(cases, 4).into_iter().map(f64::to_bits).collect(),
+            )
+        }
+    }
+
+    #[test]
+    fn stepping_is_next_up_and_next_down_lane_by_lane_on_every_path() {
+        let cases = stepping_cases();
+        let single: Vec<u32> = cases
+            .iter()
+            .map(|&(v, d)| stepped_alone(v, d, f32::next_up, f32::next_down).to_bits())
+            .collect();
+        let double: Vec<u64> = cases
+            .iter()
+            .map(|&(v, d)| stepped_alone(f64::from(v), f64::from(d), f64::next_up, f64::next_down).to_bits())
+            .collect();
+        let expected = (single.clone(), single, double.clone(), double);
+        let mut results = vec![Stepping(cases.clone()).run::<Portable>()];
+        #[cfg(target_arch = "x86_64")]
+        {
+            // SAFETY: each trampoline runs only where the processor supports it.
+            results.extend(x86::has_avx2().then(|| unsafe { x86::run_avx2(Stepping(cases.clone())) }));
+            #[cfg(feature = "avx512")]
+            results.extend(x86::has_avx512().then(|| unsafe { x86::run_avx512(Stepping(cases.clone())) }));
+        }
+        for result in results {
+            assert_eq!(result, expected);
         }
     }
 

@@ -88,7 +88,7 @@ impl MaskOps for Bits {
 /// and scalarise every loop again (the eight-lane integrator's portable copy alone took most of
 /// the crate's release build). The operations and their order are the same either way.
 macro_rules! array_lanes {
-    ($t:ty, $n:literal, [$($lane:literal),*]) => {
+    ($t:ty, $bits:ty, $n:literal, [$($lane:literal),*]) => {
         impl Array<$t, $n> {
             #[inline(always)]
             fn zip(self, other: Self, f: impl Fn($t, $t) -> $t) -> Self {
@@ -208,11 +208,25 @@ macro_rules! array_lanes {
                 let (t, f) = (if_true.0, if_false.0);
                 Array([$(if mask.0 & (1 << $lane) != 0 { t[$lane] } else { f[$lane] }),*])
             }
+            #[inline(always)]
+            fn adjust_bits(self, increment: Bits, decrement: Bits) -> Self {
+                let a = self.0;
+                let step = |lane: usize| -> $bits {
+                    if increment.0 & (1 << lane) != 0 {
+                        1
+                    } else if decrement.0 & (1 << lane) != 0 {
+                        <$bits>::MAX
+                    } else {
+                        0
+                    }
+                };
+                Array([$(<$t>::from_bits(a[$lane].to_bits().wrapping_add(step($lane)))),*])
+            }
         }
     };
 }
 
-array_lanes!(f32, 4, [0, 1, 2, 3]);
-array_lanes!(f32, 8, [0, 1, 2, 3, 4, 5, 6, 7]);
-array_lanes!(f64, 4, [0, 1, 2, 3]);
-array_lanes!(f64, 8, [0, 1, 2, 3, 4, 5, 6, 7]);
+array_lanes!(f32, u32, 4, [0, 1, 2, 3]);
+array_lanes!(f32, u32, 8, [0, 1, 2, 3, 4, 5, 6, 7]);
+array_lanes!(f64, u64, 4, [0, 1, 2, 3]);
+array_lanes!(f64, u64, 8, [0, 1, 2, 3, 4, 5, 6, 7]);

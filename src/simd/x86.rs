@@ -134,7 +134,8 @@ macro_rules! register_lanes {
         add: $add:ident, sub: $sub:ident, mul: $mul:ident, div: $div:ident, sqrt: $sqrt:ident,
         max: $max:ident, min: $min:ident, and: $and:ident, or: $or:ident, andnot: $andnot:ident,
         xor: $xor:ident, blend: $blend:ident, movemask: $movemask:ident,
-        cmp: |$a:ident, $b:ident, $pred:ident| $cmp:expr
+        cmp: |$a:ident, $b:ident, $pred:ident| $cmp:expr,
+        bits: $to_bits:ident, from_bits: $from_bits:ident, int_add: $int_add:ident, int_sub: $int_sub:ident
     ) => {
         #[derive(Clone, Copy, Debug)]
         pub struct $name($reg);
@@ -268,6 +269,14 @@ macro_rules! register_lanes {
             fn select(mask: $mask, if_true: Self, if_false: Self) -> Self {
                 $name(unsafe { $blend(if_false.0, if_true.0, mask.0) })
             }
+            #[inline(always)]
+            fn adjust_bits(self, increment: $mask, decrement: $mask) -> Self {
+                // A set mask lane is all ones, −1 as an integer.
+                $name(unsafe {
+                    let bits = $int_sub($to_bits(self.0), $to_bits(increment.0));
+                    $from_bits($int_add(bits, $to_bits(decrement.0)))
+                })
+            }
         }
     };
 }
@@ -278,7 +287,8 @@ register_lanes!(
     add: _mm_add_ps, sub: _mm_sub_ps, mul: _mm_mul_ps, div: _mm_div_ps, sqrt: _mm_sqrt_ps,
     max: _mm_max_ps, min: _mm_min_ps, and: _mm_and_ps, or: _mm_or_ps, andnot: _mm_andnot_ps,
     xor: _mm_xor_ps, blend: _mm_blendv_ps, movemask: _mm_movemask_ps,
-    cmp: |a, b, P| _mm_cmp_ps::<P>(a, b)
+    cmp: |a, b, P| _mm_cmp_ps::<P>(a, b),
+    bits: _mm_castps_si128, from_bits: _mm_castsi128_ps, int_add: _mm_add_epi32, int_sub: _mm_sub_epi32
 );
 
 register_lanes!(
@@ -287,7 +297,8 @@ register_lanes!(
     add: _mm256_add_ps, sub: _mm256_sub_ps, mul: _mm256_mul_ps, div: _mm256_div_ps, sqrt: _mm256_sqrt_ps,
     max: _mm256_max_ps, min: _mm256_min_ps, and: _mm256_and_ps, or: _mm256_or_ps, andnot: _mm256_andnot_ps,
     xor: _mm256_xor_ps, blend: _mm256_blendv_ps, movemask: _mm256_movemask_ps,
-    cmp: |a, b, P| _mm256_cmp_ps::<P>(a, b)
+    cmp: |a, b, P| _mm256_cmp_ps::<P>(a, b),
+    bits: _mm256_castps_si256, from_bits: _mm256_castsi256_ps, int_add: _mm256_add_epi32, int_sub: _mm256_sub_epi32
 );
 
 register_lanes!(
@@ -296,7 +307,8 @@ register_lanes!(
     add: _mm256_add_pd, sub: _mm256_sub_pd, mul: _mm256_mul_pd, div: _mm256_div_pd, sqrt: _mm256_sqrt_pd,
     max: _mm256_max_pd, min: _mm256_min_pd, and: _mm256_and_pd, or: _mm256_or_pd, andnot: _mm256_andnot_pd,
     xor: _mm256_xor_pd, blend: _mm256_blendv_pd, movemask: _mm256_movemask_pd,
-    cmp: |a, b, P| _mm256_cmp_pd::<P>(a, b)
+    cmp: |a, b, P| _mm256_cmp_pd::<P>(a, b),
+    bits: _mm256_castpd_si256, from_bits: _mm256_castsi256_pd, int_add: _mm256_add_epi64, int_sub: _mm256_sub_epi64
 );
 
 /// Eight `f64` lanes as two halves of four.
@@ -409,6 +421,13 @@ impl Lanes for F64x8 {
         F64x8([
             F64x4::select(mask.0[0], if_true.0[0], if_false.0[0]),
             F64x4::select(mask.0[1], if_true.0[1], if_false.0[1]),
+        ])
+    }
+    #[inline(always)]
+    fn adjust_bits(self, increment: M64x8, decrement: M64x8) -> Self {
+        F64x8([
+            self.0[0].adjust_bits(increment.0[0], decrement.0[0]),
+            self.0[1].adjust_bits(increment.0[1], decrement.0[1]),
         ])
     }
 }
