@@ -36,7 +36,7 @@ impl Aggregate {
             for pack in &self.spheres {
                 for k in set_lanes(pack.live()) {
                     let sphere = pack.sphere(k);
-                    let (hits, t) = sphere.intersect_rays::<I>(&sphere_rays, infinity);
+                    let (hits, t) = sphere.intersect_rays::<I>(&sphere_rays, infinity, active);
                     let nearer = hits & active & t.lt(nearest).bits();
                     if nearer != 0 {
                         let chosen = mask::<I>(nearer);
@@ -118,7 +118,7 @@ impl Aggregate {
                     if blocked == active {
                         break;
                     }
-                    blocked |= pack.sphere(k).intersect_rays::<I>(&sphere_rays, t_max).0 & active;
+                    blocked |= pack.sphere(k).intersect_rays::<I>(&sphere_rays, t_max, active & !blocked).0 & active;
                 }
             }
         }
