@@ -70,18 +70,32 @@ impl<'a> WhittedLanes<'a> {
             #[inline(always)]
             fn run<I: Isa>(self) -> Traced {
                 let (lanes, raster, (width, height), first_hits, rays) = (self.0, self.1, self.2, self.3, self.4);
-                let mut axes = [[0.0; LANES]; 2];
-                for lane in 0..LANES {
-                    let point = raster[lane.min(raster.len() - 1)];
-                    (axes[0][lane], axes[1][lane]) = (point.x, point.y);
-                }
-                let (x, y) = (R8::<I>::load(&axes[0]), R8::<I>::load(&axes[1]));
+                let (x, y) = raster_lanes::<I>(raster);
                 let primaries = lanes.scene.camera.ray_lanes::<I>(x, y, width, height);
                 lanes.trace_lanes::<I>(primaries, raster.len(), first_hits, rays)
             }
         }
         debug_assert!((1..=LANES).contains(&raster.len()));
         dispatch(Trace(self, raster, (width, height), first_hits, rays))
+    }
+
+    /// What the camera rays through one to eight points of the raster of an image of `width ×
+    /// height` hit first: each one's `t` and shading normal, as [`WhittedLanes::trace`] gives
+    /// them, without shading anything. The caller counts the rays.
+    pub fn first_hits(&self, raster: &[Vec2], (width, height): (u32, u32)) -> [Option<(Real, Vec3)>; LANES] {
+        struct FirstHits<'a>(&'a Scene, &'a [Vec2], (u32, u32));
+        impl Kernel for FirstHits<'_> {
+            type Output = [Option<(Real, Vec3)>; LANES];
+            #[inline(always)]
+            fn run<I: Isa>(self) -> Self::Output {
+                let (scene, raster, (width, height)) = (self.0, self.1, self.2);
+                let (x, y) = raster_lanes::<I>(raster);
+                let hit = scene.geometry.intersect_packet::<I>(&scene.camera.ray_lanes::<I>(x, y, width, height), (1 << raster.len()) - 1);
+                first_hits(&hit)
+            }
+        }
+        debug_assert!((1..=LANES).contains(&raster.len()));
+        dispatch(FirstHits(self.scene, raster, (width, height)))
     }
 
     /// The first `count` lanes of `rays` traced.
@@ -100,11 +114,7 @@ impl<'a> WhittedLanes<'a> {
             }
             active &= hit.hits;
             if depth == 0 && first_hits {
-                let (normals, mut t) = (hit.surface.shading_normal.vectors(), [0.0; LANES]);
-                hit.surface.t.store(&mut t);
-                for k in set_lanes(active) {
-                    first[k] = Some((t[k], normals[k]));
-                }
+                first = self::first_hits(&hit);
             }
             if active == 0 {
                 break;
@@ -213,6 +223,29 @@ impl<'a> WhittedLanes<'a> {
             _ => direction.normalize(),
         }
     }
+}
+
+/// The points of `raster` (one to eight) as lanes of `x` and `y`; lanes past the end repeat the
+/// last point.
+#[inline(always)]
+fn raster_lanes<I: Isa>(raster: &[Vec2]) -> (R8<I>, R8<I>) {
+    let mut axes = [[0.0; LANES]; 2];
+    for lane in 0..LANES {
+        let point = raster[lane.min(raster.len() - 1)];
+        (axes[0][lane], axes[1][lane]) = (point.x, point.y);
+    }
+    (R8::<I>::load(&axes[0]), R8::<I>::load(&axes[1]))
+}
+
+/// Each lane's `t` and shading normal, for the lanes that hit something.
+#[inline(always)]
+fn first_hits<I: Isa>(hit: &HitLanes<I>) -> [Option<(Real, Vec3)>; LANES] {
+    let (normals, mut t, mut first) = (hit.surface.shading_normal.vectors(), [0.0; LANES], [None; LANES]);
+    hit.surface.t.store(&mut t);
+    for k in set_lanes(hit.hits) {
+        first[k] = Some((t[k], normals[k]));
+    }
+    first
 }
 
 /// [`Material::shade`](super::scene::material::Material::shade) lane by lane, for the lanes of

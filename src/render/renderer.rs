@@ -140,16 +140,13 @@ fn render_pixels<C: RayCounter, F: FaultPolicy, M: Moments>(
             let first = band_index * band;
             match pixels.runs() {
                 Some(lanes) => {
-                    let (width, height) = (options.trace.width, options.trace.height);
+                    let size = (options.trace.width, options.trace.height);
                     for start in (0..pixel_count).step_by(LANES) {
                         let end = (start + LANES).min(pixel_count);
                         let mut rays = RayCounts::default();
-                        let mut centres = [Vec2::ZERO; LANES];
-                        for (centre, index) in centres.iter_mut().zip(first + start..first + end) {
-                            *centre = pixel_centre((index % width as usize) as u32, (index / width as usize) as u32);
-                        }
+                        let centres = pixel_centres(first + start..first + end, width);
                         rays.camera += (end - start) as u64;
-                        let traced = lanes.trace(&centres[..end - start], (width, height), options.aovs, &mut rays);
+                        let traced = lanes.trace(&centres[..end - start], size, options.aovs, &mut rays);
                         counter.add(&rays);
                         for (k, offset) in (start..end).enumerate() {
                             store(offset, Pixel::new(M::single(traced.color[k]), traced.first[k]));
@@ -158,13 +155,21 @@ fn render_pixels<C: RayCounter, F: FaultPolicy, M: Moments>(
                 }
                 None => {
                     let mut scratch = Samples::default();
-                    for offset in 0..pixel_count {
-                        let index = first + offset;
-                        let (x, y) = ((index % width) as u32, (index / width) as u32);
+                    for start in (0..pixel_count).step_by(LANES) {
+                        let end = (start + LANES).min(pixel_count);
                         let mut rays = RayCounts::default();
-                        let pixel = pixels.pixel::<M>(x, y, &mut rays, &mut scratch);
+                        let centres = pixel_centres(first + start..first + end, width);
+                        let firsts = pixels.first_hits(&centres[..end - start], &mut rays);
+                        for (k, offset) in (start..end).enumerate() {
+                            let index = first + offset;
+                            let (x, y) = ((index % width) as u32, (index / width) as u32);
+                            let pixel = match &firsts {
+                                Some(firsts) => Pixel::new(pixels.samples::<M>(x, y, &mut rays, &mut scratch), firsts[k]),
+                                None => pixels.pixel::<M>(x, y, &mut rays, &mut scratch),
+                            };
+                            store(offset, pixel);
+                        }
                         counter.add(&rays);
-                        store(offset, pixel);
                     }
                 }
             }
@@ -220,18 +225,27 @@ impl<F: FaultPolicy> PixelRenderer<'_, F> {
     fn pixel<M: Moments>(&self, x: u32, y: u32, rays: &mut RayCounts, scratch: &mut Samples) -> Pixel<M> {
         let (width, height) = (self.options.trace.width, self.options.trace.height);
         let centre = pixel_centre(x, y);
-        let subpixels: &[(u32, u32, Real)] = match self.options.trace.filter {
-            Filter::None if self.sampler.samples_per_pixel() == 1 => {
-                rays.camera += 1;
-                let ray = self.scene.camera.ray(centre, width, height);
-                let (color, first) = self.integrator.trace(ray, rays);
-                let first = first.filter(|_| self.options.aovs).map(|hit| (hit.surface.t, hit.surface.shading_normal));
-                return Pixel::new(M::single(color), first);
-            }
-            Filter::None => &[(0, 0, 1.0)],
-            Filter::Gaussian => &GAUSSIAN_SUBPIXELS,
+        if self.options.trace.filter == Filter::None && self.sampler.samples_per_pixel() == 1 {
+            rays.camera += 1;
+            let ray = self.scene.camera.ray(centre, width, height);
+            let (color, first) = self.integrator.trace(ray, rays);
+            let first = first.filter(|_| self.options.aovs).map(|hit| (hit.surface.t, hit.surface.shading_normal));
+            return Pixel::new(M::single(color), first);
+        }
+        let color = self.samples(x, y, rays, scratch);
+        let first = self.first_hit(centre, rays).map(|hit| (hit.surface.t, hit.surface.shading_normal));
+        Pixel::new(color, first)
+    }
+
+    /// The colour of pixel `(x, y)` (with its moments `M`) from all its samples: each sub-pixel
+    /// of the filter takes the sampler's samples. Every ray traced is added to `rays`; `scratch`
+    /// holds the samples on the way.
+    fn samples<M: Moments>(&self, x: u32, y: u32, rays: &mut RayCounts, scratch: &mut Samples) -> M {
+        let (width, height) = (self.options.trace.width, self.options.trace.height);
+        let (subpixels, scale): (&[(u32, u32, Real)], u32) = match self.options.trace.filter {
+            Filter::None => (&[(0, 0, 1.0)], 1),
+            Filter::Gaussian => (&GAUSSIAN_SUBPIXELS, 3),
         };
-        let scale = if self.options.trace.filter == Filter::Gaussian { 3 } else { 1 };
         let count = self.sampler.samples_per_pixel() as usize;
         // The samples in order: sub-pixel by sub-pixel, each sub-pixel's `count` samples.
         scratch.points.clear();
@@ -253,8 +267,20 @@ impl<F: FaultPolicy> PixelRenderer<'_, F> {
                 color.add_weighted(&finished, weight);
             }
         }
-        let first = self.first_hit(centre, rays).map(|hit| (hit.surface.t, hit.surface.shading_normal));
-        Pixel::new(color, first)
+        color
+    }
+
+    /// What the rays through the centres of up to eight pixels hit first (its `t` and shading
+    /// normal), for the AOVs, traced as one packet; all `None` when no AOV is written. `None`
+    /// when the eight-lane integrator cannot draw the picture: [`PixelRenderer::pixel`] then
+    /// traces each pixel's AOV ray alone, through the faults.
+    fn first_hits(&self, centres: &[Vec2], rays: &mut RayCounts) -> Option<[Option<(Real, Vec3)>; LANES]> {
+        let lanes = self.lanes.as_ref()?;
+        if !self.options.aovs {
+            return Some([None; LANES]);
+        }
+        rays.aov += centres.len() as u64;
+        Some(lanes.first_hits(centres, (self.options.trace.width, self.options.trace.height)))
     }
 
     /// The colours seen along the camera rays through `points`, on the raster of an image of
@@ -286,6 +312,16 @@ impl<F: FaultPolicy> PixelRenderer<'_, F> {
         let ray = self.scene.camera.ray(centre, self.options.trace.width, self.options.trace.height);
         faults::intersect(self.scene, &ray, self.faults)
     }
+}
+
+/// The centres of the pixels of `indices` (row-major in an image `width` pixels wide), at most
+/// eight; the lanes past them are left at zero.
+fn pixel_centres(indices: std::ops::Range<usize>, width: usize) -> [Vec2; LANES] {
+    let mut centres = [Vec2::ZERO; LANES];
+    for (centre, index) in centres.iter_mut().zip(indices) {
+        *centre = pixel_centre((index % width) as u32, (index / width) as u32);
+    }
+    centres
 }
 
 /// The centre of pixel `(x, y)` on the raster.
