@@ -79,6 +79,29 @@ impl<'a> WhittedLanes<'a> {
         dispatch(Trace(self, raster, (width, height), first_hits, rays))
     }
 
+    /// The colours seen along the camera rays through every point of `raster`, on the raster of
+    /// an image of `width × height`, appended to `colors` in order: [`WhittedLanes::trace`] eight
+    /// points at a time, in one call into the SIMD path for the lot, so that a pixel's samples
+    /// pay for the dispatch and for no [`Traced`] once per eight. The caller counts the camera
+    /// rays; the shadow and reflection rays are added to `rays`.
+    pub fn colors(&self, raster: &[Vec2], (width, height): (u32, u32), rays: &mut RayCounts, colors: &mut Vec<Color>) {
+        struct Colors<'a, 'b>(&'a WhittedLanes<'a>, &'b [Vec2], (u32, u32), &'b mut RayCounts, &'b mut Vec<Color>);
+        impl Kernel for Colors<'_, '_> {
+            type Output = ();
+            #[inline(always)]
+            fn run<I: Isa>(self) {
+                let (lanes, raster, (width, height), rays, colors) = (self.0, self.1, self.2, self.3, self.4);
+                for batch in raster.chunks(LANES) {
+                    let (x, y) = raster_lanes::<I>(batch);
+                    let primaries = lanes.scene.camera.ray_lanes::<I>(x, y, width, height);
+                    let traced = lanes.trace_lanes::<I>(primaries, batch.len(), false, rays);
+                    colors.extend_from_slice(&traced.color[..batch.len()]);
+                }
+            }
+        }
+        dispatch(Colors(self, raster, (width, height), rays, colors))
+    }
+
     /// What the camera rays through one to eight points of the raster of an image of `width ×
     /// height` hit first: each one's `t` and shading normal, as [`WhittedLanes::trace`] gives
     /// them, without shading anything. The caller counts the rays.

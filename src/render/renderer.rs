@@ -296,10 +296,7 @@ impl<F: FaultPolicy> PixelRenderer<'_, F> {
             }
             return;
         };
-        for batch in points.chunks(LANES) {
-            let traced = lanes.trace(batch, (width, height), false, rays);
-            colors.extend_from_slice(&traced.color[..batch.len()]);
-        }
+        lanes.colors(points, (width, height), rays, colors);
     }
 
     /// The AOVs come from one ray through the output pixel's centre: depth and normals averaged
