@@ -23,14 +23,11 @@ use super::real::{Color, Real, Vec3, to_f32};
 
 /// The moments a pixel carries from its samples to the film.
 pub trait Moments: Sized {
-    /// What a (sub)pixel adds its samples into.
-    type Accumulator: Default;
     /// One band of rows' variances for the film (nothing for [`MeanOnly`]).
     type Band: Send;
 
-    fn push(accumulator: &mut Self::Accumulator, sample: Color);
-    /// The moments of `count` pushed samples.
-    fn of(accumulator: Self::Accumulator, count: u32) -> Self;
+    /// The moments of a (sub)pixel's samples, summed in their order (a pixel always has one).
+    fn of_samples(samples: &[Color]) -> Self;
     /// One sample through the pixel centre: no spread to speak of.
     fn single(color: Color) -> Self;
     fn zero() -> Self;
@@ -47,20 +44,16 @@ pub trait Moments: Sized {
 /// The mean colour only: one sample per pixel (or per sub-pixel of the filter).
 pub struct MeanOnly(Color);
 
-#[derive(Default)]
-pub struct Sum(Color);
-
 impl Moments for MeanOnly {
-    type Accumulator = Sum;
     type Band = ();
 
     #[inline]
-    fn push(sum: &mut Sum, sample: Color) {
-        sum.0 += sample;
-    }
-    #[inline]
-    fn of(sum: Sum, count: u32) -> Self {
-        MeanOnly(sum.0 / count as Real)
+    fn of_samples(samples: &[Color]) -> Self {
+        let mut sum = Color::ZERO;
+        for &sample in samples {
+            sum += sample;
+        }
+        MeanOnly(sum / samples.len() as Real)
     }
     fn single(color: Color) -> Self {
         MeanOnly(color)
@@ -88,45 +81,30 @@ pub struct WithVariance {
     variance: Color,
 }
 
-/// The samples' sum (exactly [`MeanOnly`]'s) and their sums shifted by the first sample, which
-/// keeps `Σd² − (Σd)²/n` free of cancellation in `f32` when the samples are close together.
-#[derive(Default)]
-pub struct ShiftedSums {
-    count: u32,
-    shift: Color,
-    sum: Color,
-    shifted: Color,
-    squares: Color,
-}
-
 impl Moments for WithVariance {
-    type Accumulator = ShiftedSums;
     type Band = Vec<[f32; 3]>;
 
+    /// The samples' sum (exactly [`MeanOnly`]'s), and their sums shifted by the first sample,
+    /// which keeps `Σd² − (Σd)²/n` free of cancellation in `f32` when the samples are close
+    /// together. The first sample's own shift is zero (or NaN, as any sum with a NaN is).
     #[inline]
-    fn push(sums: &mut ShiftedSums, sample: Color) {
-        if sums.count == 0 {
-            sums.shift = sample;
+    fn of_samples(samples: &[Color]) -> Self {
+        let shift = samples.first().copied().unwrap_or(Color::ZERO);
+        let (mut sum, mut shifted, mut squares) = (Color::ZERO, Color::ZERO, Color::ZERO);
+        for &sample in samples {
+            let d = sample - shift;
+            sum += sample;
+            shifted += d;
+            squares += d * d;
         }
-        let d = sample - sums.shift;
-        sums.count += 1;
-        sums.sum += sample;
-        sums.shifted += d;
-        sums.squares += d * d;
-    }
-    #[inline]
-    fn of(sums: ShiftedSums, count: u32) -> Self {
-        let n = count as Real;
-        let variance = if count > 1 {
-            let spread = sums.squares - sums.shifted * sums.shifted / n;
+        let n = samples.len() as Real;
+        let variance = if samples.len() > 1 {
+            let spread = squares - shifted * shifted / n;
             (spread / ((n - 1.0) * n)).max(Color::ZERO)
         } else {
             Color::ZERO
         };
-        WithVariance {
-            mean: sums.sum / n,
-            variance,
-        }
+        WithVariance { mean: sum / n, variance }
     }
     fn single(color: Color) -> Self {
         WithVariance {
@@ -170,11 +148,7 @@ mod tests {
     use super::*;
 
     fn moments(samples: &[Real]) -> WithVariance {
-        let mut sums = ShiftedSums::default();
-        for &s in samples {
-            WithVariance::push(&mut sums, Color::splat(s));
-        }
-        WithVariance::of(sums, samples.len() as u32)
+        WithVariance::of_samples(&samples.iter().map(|&s| Color::splat(s)).collect::<Vec<_>>())
     }
 
     #[test]
@@ -189,11 +163,7 @@ mod tests {
     fn equal_samples_have_no_variance_and_the_mean_is_the_plain_sum() {
         let m = moments(&[0.3; 16]);
         assert_eq!(m.variance, Color::ZERO);
-        let mut sum = Sum::default();
-        for _ in 0..16 {
-            MeanOnly::push(&mut sum, Color::splat(0.3));
-        }
-        assert_eq!(MeanOnly::of(sum, 16).0, m.mean);
+        assert_eq!(MeanOnly::of_samples(&[Color::splat(0.3); 16]).0, m.mean);
     }
 
     #[test]

@@ -256,11 +256,7 @@ impl<F: FaultPolicy> PixelRenderer<'_, F> {
         self.trace_points(&scratch.points, (scale * width, scale * height), rays, &mut scratch.colors);
         let mut color = M::zero();
         for (colors, &(_, _, weight)) in scratch.colors.chunks_exact(count).zip(subpixels) {
-            let mut moments = M::Accumulator::default();
-            for &sample in colors {
-                M::push(&mut moments, sample);
-            }
-            let finished = M::of(moments, count as u32);
+            let finished = M::of_samples(colors);
             if scale == 1 {
                 color = finished;
             } else {
