@@ -243,7 +243,10 @@ impl<I: Isa> SurfaceLanes<I> {
     pub fn with_lanes(&self, hits: &[Option<SurfaceHit>; LANES]) -> Self {
         let mut t = [0.0; LANES];
         self.t.store(&mut t);
-        let mut vectors = [self.point, self.point_error, self.geometric_normal, self.shading_normal].map(V3::store);
+        // Each field spelled out: `array::map` would take the loads and stores into a closure,
+        // compiled without the kernel's target features.
+        let mut vectors =
+            [self.point.store(), self.point_error.store(), self.geometric_normal.store(), self.shading_normal.store()];
         for (lane, hit) in hits.iter().enumerate() {
             if let Some(hit) = hit {
                 t[lane] = hit.t;
@@ -254,7 +257,8 @@ impl<I: Isa> SurfaceLanes<I> {
                 }
             }
         }
-        let [point, point_error, geometric_normal, shading_normal] = vectors.map(|axes| V3::load(&axes));
+        let [point, point_error, geometric_normal, shading_normal] =
+            [V3::load(&vectors[0]), V3::load(&vectors[1]), V3::load(&vectors[2]), V3::load(&vectors[3])];
         SurfaceLanes { t: R8::<I>::load(&t), point, point_error, geometric_normal, shading_normal }
     }
 }

@@ -2,7 +2,7 @@
 //! and everything else under a BVH.
 
 use super::geometry::aabb::{Aabb, SlabRay};
-use super::geometry::bvh::{BoxSet, Bvh, LeafCost, Visit, VisitFn, WIDTH, traverse};
+use super::geometry::bvh::{BoxSet, Bvh, LeafCost, LeafVisitor, Visit, WIDTH, traverse};
 use super::geometry::plane::{PLANE_LANES, Plane, PlanePack, intersect_planes};
 use super::geometry::sphere::{SPHERE_LANES, Sphere, SphereRay, SpherePack, intersect_spheres};
 use super::geometry::{Ray, SurfaceHit};
@@ -233,15 +233,8 @@ impl Aggregate {
                 }
             }
             Rest::Tree { bvh, objects } => {
-                traverse::<I>(bvh.nodes(), ray, closest.t, &mut VisitFn(|first: u32, count: u32, t_limit: &mut Real| {
-                    for &index in &objects[first as usize..(first + count) as usize] {
-                        if let Some(hit) = self.traced[index as usize].intersect_lanes::<I>(ray, *t_limit) {
-                            closest.offer(hit.t(), index, Found::Object(index, hit));
-                            *t_limit = closest.t;
-                        }
-                    }
-                    Visit::Continue
-                }));
+                let t_max = closest.t;
+                traverse::<I>(bvh.nodes(), ray, t_max, &mut ClosestInLeaves { aggregate: self, objects, ray, closest });
             }
         }
     }
@@ -294,19 +287,56 @@ impl Aggregate {
                 false
             }
             Rest::Tree { bvh, objects } => {
-                let mut blocked = false;
-                traverse::<I>(bvh.nodes(), ray, t_max, &mut VisitFn(|first: u32, count: u32, t_limit: &mut Real| {
-                    let leaf = &objects[first as usize..(first + count) as usize];
-                    if leaf.iter().any(|&index| self.traced[index as usize].occluded_lanes::<I>(ray, *t_limit)) {
-                        blocked = true;
-                        Visit::Stop
-                    } else {
-                        Visit::Continue
-                    }
-                }));
-                blocked
+                let mut blockers = BlockersInLeaves { aggregate: self, objects, ray, blocked: false };
+                traverse::<I>(bvh.nodes(), ray, t_max, &mut blockers);
+                blockers.blocked
             }
         }
+    }
+}
+
+/// [`Aggregate::closest_rest`]'s visitor of the rest's tree: offers `closest` every object of
+/// each leaf reached. A visitor, not a closure: a closure is compiled on its own, without the
+/// kernel's target features, and runs every lane operation of the objects' tests as a call.
+struct ClosestInLeaves<'a> {
+    aggregate: &'a Aggregate,
+    objects: &'a [u32],
+    ray: &'a Ray,
+    closest: &'a mut Closest,
+}
+
+impl<I: Isa> LeafVisitor<I> for ClosestInLeaves<'_> {
+    #[inline(always)]
+    fn leaf(&mut self, first: u32, count: u32, t_limit: &mut Real) -> Visit {
+        for &index in &self.objects[first as usize..(first + count) as usize] {
+            if let Some(hit) = self.aggregate.traced[index as usize].intersect_lanes::<I>(self.ray, *t_limit) {
+                self.closest.offer(hit.t(), index, Found::Object(index, hit));
+                *t_limit = self.closest.t;
+            }
+        }
+        Visit::Continue
+    }
+}
+
+/// [`Aggregate::any_rest`]'s visitor of the rest's tree: stops at the first object of a leaf
+/// that blocks the ray (a visitor for the reason [`ClosestInLeaves`] is).
+struct BlockersInLeaves<'a> {
+    aggregate: &'a Aggregate,
+    objects: &'a [u32],
+    ray: &'a Ray,
+    blocked: bool,
+}
+
+impl<I: Isa> LeafVisitor<I> for BlockersInLeaves<'_> {
+    #[inline(always)]
+    fn leaf(&mut self, first: u32, count: u32, t_limit: &mut Real) -> Visit {
+        for &index in &self.objects[first as usize..(first + count) as usize] {
+            if self.aggregate.traced[index as usize].occluded_lanes::<I>(self.ray, *t_limit) {
+                self.blocked = true;
+                return Visit::Stop;
+            }
+        }
+        Visit::Continue
     }
 }
 
@@ -340,5 +370,56 @@ mod tests {
         assert_eq!(aggregate.intersect(&ray).expect("hit").material, 3);
         let planes_only = Aggregate::new(Vec::new(), vec![(on_the_sphere, 7), (on_the_sphere, 8)]);
         assert_eq!(planes_only.intersect(&ray).expect("hit").material, 7);
+    }
+
+    /// In a tree of the rest's objects, a ray is blocked before `t_max` exactly when its closest
+    /// hit is nearer than `t_max`, and the closest hit is the nearest sphere along it: both leaf
+    /// visitors see every object of the leaves they reach.
+    #[test]
+    fn a_tree_of_objects_blocks_where_its_closest_hit_is_nearer() {
+        let spheres: Vec<Object> = (0..20)
+            .map(|i| {
+                let center = Vec3::new((i % 5) as Real * 2.5 - 5.0, (i / 5) as Real * 2.5 - 3.75, -((i % 3) as Real));
+                Object { shape: Shape::Sphere(Sphere { center, radius: 1.0 }), transform: None, material: i }
+            })
+            .collect();
+        let centers: Vec<Vec3> = spheres
+            .iter()
+            .map(|object| match &object.shape {
+                Shape::Sphere(sphere) => sphere.center,
+                _ => unreachable!(),
+            })
+            .collect();
+        let aggregate = Aggregate::new(spheres, Vec::new());
+        assert!(aggregate.bvh().is_some(), "20 spheres make a tree");
+        let (mut hits, mut misses) = (0, 0);
+        for y in -30..30 {
+            for x in -30..30 {
+                let origin = Vec3::new(x as Real * 0.23, y as Real * 0.17, 10.0);
+                let ray = Ray::new(origin, Vec3::new(0.0, 0.0, -1.0));
+                let closest = aggregate.intersect(&ray);
+                let nearest = centers
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, c)| (origin.truncate() - c.truncate()).length_squared() < 1.0 - 1e-3)
+                    .min_by(|a, b| b.1.z.total_cmp(&a.1.z))
+                    .map(|(i, _)| i as u32);
+                match &closest {
+                    Some(hit) => {
+                        hits += 1;
+                        if let Some(nearest) = nearest {
+                            assert_eq!(hit.material, nearest, "ray from {origin}");
+                        }
+                        assert!(aggregate.occluded(&ray, hit.surface.t * 1.001), "ray from {origin}");
+                        assert!(!aggregate.occluded(&ray, hit.surface.t * 0.999), "ray from {origin}");
+                    }
+                    None => {
+                        misses += 1;
+                        assert!(!aggregate.occluded(&ray, Real::INFINITY), "ray from {origin}");
+                    }
+                }
+            }
+        }
+        assert!(hits > 500 && misses > 500, "{hits} hits, {misses} misses");
     }
 }
