@@ -15,7 +15,7 @@ use super::real::{Color, R8, Real, Vec2, Vec3};
 use super::scene::light::Light;
 use super::scene::{Background, HitLanes, Scene};
 use crate::options::Spawn;
-use crate::simd::{Isa, Lanes, MaskOps};
+use crate::simd::{Isa, Kernel, Lanes, MaskOps, dispatch};
 use crate::stats::RayCounts;
 
 /// What up to eight primary rays saw.
@@ -62,37 +62,63 @@ impl<'a> WhittedLanes<'a> {
 
     /// The colour seen along the camera rays through one to eight points of the raster of an
     /// image of `width × height`, and, when `first_hits`, what each ray hit first. The caller
-    /// counts the camera rays; the shadow and reflection rays are added to `rays`. Inlined into
-    /// the caller's kernel: the render loop goes into the SIMD path once per band.
-    #[inline(always)]
-    pub(super) fn trace_in<I: Isa>(&self, raster: &[Vec2], (width, height): (u32, u32), first_hits: bool, rays: &mut RayCounts) -> Traced {
+    /// counts the camera rays; the shadow and reflection rays are added to `rays`.
+    pub fn trace(&self, raster: &[Vec2], (width, height): (u32, u32), first_hits: bool, rays: &mut RayCounts) -> Traced {
+        struct Trace<'a, 'b>(&'a WhittedLanes<'a>, &'b [Vec2], (u32, u32), bool, &'b mut RayCounts);
+        impl Kernel for Trace<'_, '_> {
+            type Output = Traced;
+            #[inline(always)]
+            fn run<I: Isa>(self) -> Traced {
+                let (lanes, raster, (width, height), first_hits, rays) = (self.0, self.1, self.2, self.3, self.4);
+                let (x, y) = raster_lanes::<I>(raster);
+                let primaries = lanes.scene.camera.ray_lanes::<I>(x, y, width, height);
+                lanes.trace_lanes::<I>(primaries, raster.len(), first_hits, rays)
+            }
+        }
         debug_assert!((1..=LANES).contains(&raster.len()));
-        let (x, y) = raster_lanes::<I>(raster);
-        let primaries = self.scene.camera.ray_lanes::<I>(x, y, width, height);
-        self.trace_lanes::<I>(primaries, raster.len(), first_hits, rays)
+        dispatch(Trace(self, raster, (width, height), first_hits, rays))
     }
 
     /// The colours seen along the camera rays through every point of `raster`, on the raster of
-    /// an image of `width × height`, appended to `colors` in order: [`WhittedLanes::trace_in`]
-    /// eight points at a time. The caller counts the camera rays; the shadow and reflection rays
-    /// are added to `rays`.
-    #[inline(always)]
-    pub(super) fn colors_in<I: Isa>(&self, raster: &[Vec2], size: (u32, u32), rays: &mut RayCounts, colors: &mut Vec<Color>) {
-        for batch in raster.chunks(LANES) {
-            let traced = self.trace_in::<I>(batch, size, false, rays);
-            colors.extend_from_slice(&traced.color[..batch.len()]);
+    /// an image of `width × height`, appended to `colors` in order: [`WhittedLanes::trace`] eight
+    /// points at a time, in one call into the SIMD path for the lot, so that a pixel's samples
+    /// pay for the dispatch and for no [`Traced`] once per eight. The caller counts the camera
+    /// rays; the shadow and reflection rays are added to `rays`.
+    pub fn colors(&self, raster: &[Vec2], (width, height): (u32, u32), rays: &mut RayCounts, colors: &mut Vec<Color>) {
+        struct Colors<'a, 'b>(&'a WhittedLanes<'a>, &'b [Vec2], (u32, u32), &'b mut RayCounts, &'b mut Vec<Color>);
+        impl Kernel for Colors<'_, '_> {
+            type Output = ();
+            #[inline(always)]
+            fn run<I: Isa>(self) {
+                let (lanes, raster, (width, height), rays, colors) = (self.0, self.1, self.2, self.3, self.4);
+                for batch in raster.chunks(LANES) {
+                    let (x, y) = raster_lanes::<I>(batch);
+                    let primaries = lanes.scene.camera.ray_lanes::<I>(x, y, width, height);
+                    let traced = lanes.trace_lanes::<I>(primaries, batch.len(), false, rays);
+                    colors.extend_from_slice(&traced.color[..batch.len()]);
+                }
+            }
         }
+        dispatch(Colors(self, raster, (width, height), rays, colors))
     }
 
     /// What the camera rays through one to eight points of the raster of an image of `width ×
-    /// height` hit first: each one's `t` and shading normal, as [`WhittedLanes::trace_in`] gives
+    /// height` hit first: each one's `t` and shading normal, as [`WhittedLanes::trace`] gives
     /// them, without shading anything. The caller counts the rays.
-    #[inline(always)]
-    pub(super) fn first_hits_in<I: Isa>(&self, raster: &[Vec2], (width, height): (u32, u32)) -> [Option<(Real, Vec3)>; LANES] {
+    pub fn first_hits(&self, raster: &[Vec2], (width, height): (u32, u32)) -> [Option<(Real, Vec3)>; LANES] {
+        struct FirstHits<'a>(&'a Scene, &'a [Vec2], (u32, u32));
+        impl Kernel for FirstHits<'_> {
+            type Output = [Option<(Real, Vec3)>; LANES];
+            #[inline(always)]
+            fn run<I: Isa>(self) -> Self::Output {
+                let (scene, raster, (width, height)) = (self.0, self.1, self.2);
+                let (x, y) = raster_lanes::<I>(raster);
+                let hit = scene.geometry.intersect_packet::<I>(&scene.camera.ray_lanes::<I>(x, y, width, height), (1 << raster.len()) - 1);
+                first_hits(&hit)
+            }
+        }
         debug_assert!((1..=LANES).contains(&raster.len()));
-        let (x, y) = raster_lanes::<I>(raster);
-        let rays = self.scene.camera.ray_lanes::<I>(x, y, width, height);
-        first_hits(&self.scene.geometry.intersect_packet::<I>(&rays, (1 << raster.len()) - 1))
+        dispatch(FirstHits(self.scene, raster, (width, height)))
     }
 
     /// The first `count` lanes of `rays` traced.

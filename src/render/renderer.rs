@@ -128,17 +128,53 @@ fn render_pixels<C: RayCounter, F: FaultPolicy, M: Moments>(
         .zip(film.normal.par_chunks_mut(band))
         .enumerate()
         .map(|(band_index, ((color, depth), normal))| {
-            let rows = (color.len() / width) as u64;
-            let mut film = BandFilm::<M> { first: band_index * band, variance: M::band(color.len()), color, depth, normal };
-            let mut rays = RayCounts::default();
-            match &pixels.lanes {
-                Some(lanes) => lanes::render_band(lanes, sampler, options, &mut film, &mut rays),
-                None => pixels.band_one_ray_at_a_time(&mut film, &mut rays),
-            }
             let mut counter = C::default();
-            counter.add(&rays);
-            progress.advance(rows);
-            (counter, film.variance)
+            let mut variance = M::band(color.len());
+            let pixel_count = color.len();
+            let mut store = |offset: usize, pixel: Pixel<M>| {
+                color[offset] = film_vector(pixel.color.mean());
+                depth[offset] = pixel.depth;
+                normal[offset] = pixel.normal;
+                M::store(&mut variance, offset, &pixel.color);
+            };
+            let first = band_index * band;
+            match pixels.runs() {
+                Some(lanes) => {
+                    let size = (options.trace.width, options.trace.height);
+                    for start in (0..pixel_count).step_by(LANES) {
+                        let end = (start + LANES).min(pixel_count);
+                        let mut rays = RayCounts::default();
+                        let centres = pixel_centres(first + start..first + end, width);
+                        rays.camera += (end - start) as u64;
+                        let traced = lanes.trace(&centres[..end - start], size, options.aovs, &mut rays);
+                        counter.add(&rays);
+                        for (k, offset) in (start..end).enumerate() {
+                            store(offset, Pixel::new(M::single(traced.color[k]), traced.first[k]));
+                        }
+                    }
+                }
+                None => {
+                    let mut scratch = Samples::default();
+                    for start in (0..pixel_count).step_by(LANES) {
+                        let end = (start + LANES).min(pixel_count);
+                        let mut rays = RayCounts::default();
+                        let centres = pixel_centres(first + start..first + end, width);
+                        let firsts = pixels.first_hits(&centres[..end - start], &mut rays);
+                        for (k, offset) in (start..end).enumerate() {
+                            let index = first + offset;
+                            let (x, y) = ((index % width) as u32, (index / width) as u32);
+                            let pixel = match &firsts {
+                                Some(firsts) => Pixel::new(pixels.samples::<M>(x, y, &mut rays, &mut scratch), firsts[k]),
+                                None => pixels.pixel::<M>(x, y, &mut rays, &mut scratch),
+                            };
+                            store(offset, pixel);
+                        }
+                        counter.add(&rays);
+                    }
+                }
+            }
+            progress.advance((pixel_count / width) as u64);
+            (counter, variance)
         })
         .collect();
     let mut counter = C::default();
@@ -165,35 +201,6 @@ struct Pixel<M> {
     normal: [f32; 3],
 }
 
-/// One band of rows of the film as the render loop hands it out: offsets count from the band's
-/// first pixel, `first` (its row-major index in the image).
-struct BandFilm<'b, M: Moments> {
-    first: usize,
-    color: &'b mut [[f32; 3]],
-    depth: &'b mut [f32],
-    normal: &'b mut [[f32; 3]],
-    variance: M::Band,
-}
-
-impl<M: Moments> BandFilm<'_, M> {
-    fn len(&self) -> usize {
-        self.color.len()
-    }
-
-    fn store(&mut self, offset: usize, pixel: Pixel<M>) {
-        self.color[offset] = film_vector(pixel.color.mean());
-        self.depth[offset] = pixel.depth;
-        self.normal[offset] = pixel.normal;
-        M::store(&mut self.variance, offset, &pixel.color);
-    }
-}
-
-/// The band's pixel `offset` as `(x, y)` in an image `width` pixels wide.
-fn pixel_at<M: Moments>(film: &BandFilm<'_, M>, offset: usize, width: usize) -> (u32, u32) {
-    let index = film.first + offset;
-    ((index % width) as u32, (index / width) as u32)
-}
-
 struct PixelRenderer<'a, F: FaultPolicy> {
     scene: &'a Scene,
     integrator: Whitted<'a, F>,
@@ -206,38 +213,86 @@ struct PixelRenderer<'a, F: FaultPolicy> {
 }
 
 impl<F: FaultPolicy> PixelRenderer<'_, F> {
-    /// The band drawn pixel by pixel, every ray alone through the integrator and its faults.
-    fn band_one_ray_at_a_time<M: Moments>(&self, film: &mut BandFilm<'_, M>, rays: &mut RayCounts) {
-        let width = self.options.trace.width as usize;
-        let mut scratch = Samples::default();
-        for offset in 0..film.len() {
-            let (x, y) = pixel_at(film, offset, width);
-            let pixel = self.pixel::<M>(x, y, rays, &mut scratch);
-            film.store(offset, pixel);
-        }
+    /// The integrator for runs of eight pixels side by side, when pixels are one sample each
+    /// and the eight-lane integrator can draw them.
+    fn runs(&self) -> Option<&WhittedLanes<'_>> {
+        let single = self.options.trace.filter == Filter::None && self.sampler.samples_per_pixel() == 1;
+        self.lanes.as_ref().filter(|_| single)
     }
 
     /// The pixel's colour (with its moments `M`) and AOVs; every ray traced for it is added to
     /// `rays`. `scratch` holds its samples on the way.
     fn pixel<M: Moments>(&self, x: u32, y: u32, rays: &mut RayCounts, scratch: &mut Samples) -> Pixel<M> {
+        let (width, height) = (self.options.trace.width, self.options.trace.height);
         let centre = pixel_centre(x, y);
         if self.options.trace.filter == Filter::None && self.sampler.samples_per_pixel() == 1 {
             rays.camera += 1;
-            let ray = self.scene.camera.ray(centre, self.options.trace.width, self.options.trace.height);
+            let ray = self.scene.camera.ray(centre, width, height);
             let (color, first) = self.integrator.trace(ray, rays);
             let first = first.filter(|_| self.options.aovs).map(|hit| (hit.surface.t, hit.surface.shading_normal));
             return Pixel::new(M::single(color), first);
         }
-        let (width, height) = sample_points(self.sampler, self.options, (x, y), &mut scratch.points);
-        rays.camera += scratch.points.len() as u64;
-        scratch.colors.clear();
-        for &point in &scratch.points {
-            let ray = self.scene.camera.ray(point, width, height);
-            scratch.colors.push(self.integrator.trace(ray, rays).0);
-        }
-        let color = pixel_moments::<M>(self.sampler, self.options.trace.filter, &scratch.colors);
+        let color = self.samples(x, y, rays, scratch);
         let first = self.first_hit(centre, rays).map(|hit| (hit.surface.t, hit.surface.shading_normal));
         Pixel::new(color, first)
+    }
+
+    /// The colour of pixel `(x, y)` (with its moments `M`) from all its samples: each sub-pixel
+    /// of the filter takes the sampler's samples. Every ray traced is added to `rays`; `scratch`
+    /// holds the samples on the way.
+    fn samples<M: Moments>(&self, x: u32, y: u32, rays: &mut RayCounts, scratch: &mut Samples) -> M {
+        let (width, height) = (self.options.trace.width, self.options.trace.height);
+        let (subpixels, scale): (&[(u32, u32, Real)], u32) = match self.options.trace.filter {
+            Filter::None => (&[(0, 0, 1.0)], 1),
+            Filter::Gaussian => (&GAUSSIAN_SUBPIXELS, 3),
+        };
+        let count = self.sampler.samples_per_pixel() as usize;
+        // The samples in order: sub-pixel by sub-pixel, each sub-pixel's `count` samples.
+        scratch.points.clear();
+        for &(i, j, _) in subpixels {
+            let (sx, sy) = (scale * x + i, scale * y + j);
+            self.sampler.pixel(sx, sy).push_points(Vec2::new(sx as Real, sy as Real), &mut scratch.points);
+        }
+        self.trace_points(&scratch.points, (scale * width, scale * height), rays, &mut scratch.colors);
+        let mut color = M::zero();
+        for (colors, &(_, _, weight)) in scratch.colors.chunks_exact(count).zip(subpixels) {
+            let finished = M::of_samples(colors);
+            if scale == 1 {
+                color = finished;
+            } else {
+                color.add_weighted(&finished, weight);
+            }
+        }
+        color
+    }
+
+    /// What the rays through the centres of up to eight pixels hit first (its `t` and shading
+    /// normal), for the AOVs, traced as one packet; all `None` when no AOV is written. `None`
+    /// when the eight-lane integrator cannot draw the picture: [`PixelRenderer::pixel`] then
+    /// traces each pixel's AOV ray alone, through the faults.
+    fn first_hits(&self, centres: &[Vec2], rays: &mut RayCounts) -> Option<[Option<(Real, Vec3)>; LANES]> {
+        let lanes = self.lanes.as_ref()?;
+        if !self.options.aovs {
+            return Some([None; LANES]);
+        }
+        rays.aov += centres.len() as u64;
+        Some(lanes.first_hits(centres, (self.options.trace.width, self.options.trace.height)))
+    }
+
+    /// The colours seen along the camera rays through `points`, on the raster of an image of
+    /// `size`, in place of `colors`' contents and in the same order: eight at a time when the
+    /// eight-lane integrator can draw them, one at a time otherwise.
+    fn trace_points(&self, points: &[Vec2], (width, height): (u32, u32), rays: &mut RayCounts, colors: &mut Vec<Color>) {
+        rays.camera += points.len() as u64;
+        colors.clear();
+        let Some(lanes) = &self.lanes else {
+            for &point in points {
+                let ray = self.scene.camera.ray(point, width, height);
+                colors.push(self.integrator.trace(ray, rays).0);
+            }
+            return;
+        };
+        lanes.colors(points, (width, height), rays, colors);
     }
 
     /// The AOVs come from one ray through the output pixel's centre: depth and normals averaged
@@ -250,47 +305,6 @@ impl<F: FaultPolicy> PixelRenderer<'_, F> {
         let ray = self.scene.camera.ray(centre, self.options.trace.width, self.options.trace.height);
         faults::intersect(self.scene, &ray, self.faults)
     }
-}
-
-/// The sub-pixels of the filter: each one's column and row in the output pixel's block and its
-/// weight, and how many sub-pixels a side the block has.
-fn subpixels(filter: Filter) -> (&'static [(u32, u32, Real)], u32) {
-    match filter {
-        Filter::None => (&[(0, 0, 1.0)], 1),
-        Filter::Gaussian => (&GAUSSIAN_SUBPIXELS, 3),
-    }
-}
-
-/// The sample points of pixel `(x, y)` in place of `points`' contents, in their order: sub-pixel
-/// by sub-pixel of the filter, each sub-pixel's samples. Returns the size of the raster they lie
-/// on (the image's, times the filter's sub-pixels a side).
-#[inline(always)]
-fn sample_points(sampler: Sampler, options: &RenderOptions, (x, y): (u32, u32), points: &mut Vec<Vec2>) -> (u32, u32) {
-    let (subpixels, scale) = subpixels(options.trace.filter);
-    points.clear();
-    for &(i, j, _) in subpixels {
-        let (sx, sy) = (scale * x + i, scale * y + j);
-        sampler.pixel(sx, sy).push_points(Vec2::new(sx as Real, sy as Real), points);
-    }
-    (scale * options.trace.width, scale * options.trace.height)
-}
-
-/// A pixel's colour (with its moments `M`) from the colours seen through its [`sample_points`],
-/// in their order: each sub-pixel's moments, weighted by the filter.
-#[inline(always)]
-fn pixel_moments<M: Moments>(sampler: Sampler, filter: Filter, colors: &[Color]) -> M {
-    let (subpixels, scale) = subpixels(filter);
-    let count = sampler.samples_per_pixel() as usize;
-    let mut color = M::zero();
-    for (colors, &(_, _, weight)) in colors.chunks_exact(count).zip(subpixels) {
-        let finished = M::of_samples(colors);
-        if scale == 1 {
-            color = finished;
-        } else {
-            color.add_weighted(&finished, weight);
-        }
-    }
-    color
 }
 
 /// The centres of the pixels of `indices` (row-major in an image `width` pixels wide), at most
@@ -319,6 +333,5 @@ impl<M> Pixel<M> {
     }
 }
 
-mod lanes;
 #[cfg(test)]
 mod tests;
