@@ -216,8 +216,12 @@ impl<F: FaultPolicy> PixelRenderer<'_, F> {
     /// The integrator for runs of eight pixels side by side, when pixels are one sample each
     /// and the eight-lane integrator can draw them.
     fn runs(&self) -> Option<&WhittedLanes<'_>> {
-        let single = self.options.trace.filter == Filter::None && self.sampler.samples_per_pixel() == 1;
-        self.lanes.as_ref().filter(|_| single)
+        self.lanes.as_ref().filter(|_| self.one_ray_per_pixel())
+    }
+
+    /// Whether a pixel is one sample through its centre, unfiltered: its colour is one ray's.
+    fn one_ray_per_pixel(&self) -> bool {
+        self.options.trace.filter == Filter::None && self.sampler.samples_per_pixel() == 1
     }
 
     /// The pixel's colour (with its moments `M`) and AOVs; every ray traced for it is added to
@@ -225,7 +229,7 @@ impl<F: FaultPolicy> PixelRenderer<'_, F> {
     fn pixel<M: Moments>(&self, x: u32, y: u32, rays: &mut RayCounts, scratch: &mut Samples) -> Pixel<M> {
         let (width, height) = (self.options.trace.width, self.options.trace.height);
         let centre = pixel_centre(x, y);
-        if self.options.trace.filter == Filter::None && self.sampler.samples_per_pixel() == 1 {
+        if self.one_ray_per_pixel() {
             rays.camera += 1;
             let ray = self.scene.camera.ray(centre, width, height);
             let (color, first) = self.integrator.trace(ray, rays);
