@@ -158,16 +158,20 @@ fn render_pixels<C: RayCounter, F: FaultPolicy, M: Moments>(
                     for start in (0..pixel_count).step_by(LANES) {
                         let end = (start + LANES).min(pixel_count);
                         let mut rays = RayCounts::default();
-                        let centres = pixel_centres(first + start..first + end, width);
-                        let firsts = pixels.first_hits(&centres[..end - start], &mut rays);
-                        for (k, offset) in (start..end).enumerate() {
-                            let index = first + offset;
-                            let (x, y) = ((index % width) as u32, (index / width) as u32);
-                            let pixel = match &firsts {
-                                Some(firsts) => Pixel::new(pixels.samples::<M>(x, y, &mut rays, &mut scratch), firsts[k]),
-                                None => pixels.pixel::<M>(x, y, &mut rays, &mut scratch),
-                            };
-                            store(offset, pixel);
+                        let coordinates = pixel_coordinates(first + start..first + end, width);
+                        let centres = coordinates.map(|(x, y)| pixel_centre(x, y));
+                        match pixels.first_hits(&centres[..end - start], &mut rays) {
+                            Some(firsts) => {
+                                let colors = pixels.samples::<M>(&coordinates[..end - start], &mut rays, &mut scratch);
+                                for (k, color) in colors.enumerate() {
+                                    store(start + k, Pixel::new(color, firsts[k]));
+                                }
+                            }
+                            None => {
+                                for (offset, &(x, y)) in (start..end).zip(&coordinates) {
+                                    store(offset, pixels.pixel::<M>(x, y, &mut rays, &mut scratch));
+                                }
+                            }
                         }
                         counter.add(&rays);
                     }
@@ -236,38 +240,49 @@ impl<F: FaultPolicy> PixelRenderer<'_, F> {
             let first = first.filter(|_| self.options.aovs).map(|hit| (hit.surface.t, hit.surface.shading_normal));
             return Pixel::new(M::single(color), first);
         }
-        let color = self.samples(x, y, rays, scratch);
+        let color = self.samples(&[(x, y)], rays, scratch).next().expect("one pixel's samples give one colour");
         let first = self.first_hit(centre, rays).map(|hit| (hit.surface.t, hit.surface.shading_normal));
         Pixel::new(color, first)
     }
 
-    /// The colour of pixel `(x, y)` (with its moments `M`) from all its samples: each sub-pixel
-    /// of the filter takes the sampler's samples. Every ray traced is added to `rays`; `scratch`
-    /// holds the samples on the way.
-    fn samples<M: Moments>(&self, x: u32, y: u32, rays: &mut RayCounts, scratch: &mut Samples) -> M {
+    /// The colours (with their moments `M`) of the pixels at `coordinates`, in order, each from
+    /// all its samples: each sub-pixel of the filter takes the sampler's samples. The pixels'
+    /// samples are traced together, so that a run of pixels goes into the SIMD path once, not
+    /// once a pixel (a call costs far more than its instructions: see `docs/speed.md`). Every ray
+    /// traced is added to `rays`; `scratch` holds the samples on the way.
+    fn samples<'s, M: Moments>(
+        &self,
+        coordinates: &[(u32, u32)],
+        rays: &mut RayCounts,
+        scratch: &'s mut Samples,
+    ) -> impl Iterator<Item = M> + 's {
         let (width, height) = (self.options.trace.width, self.options.trace.height);
-        let (subpixels, scale): (&[(u32, u32, Real)], u32) = match self.options.trace.filter {
+        let (subpixels, scale): (&'static [(u32, u32, Real)], u32) = match self.options.trace.filter {
             Filter::None => (&[(0, 0, 1.0)], 1),
             Filter::Gaussian => (&GAUSSIAN_SUBPIXELS, 3),
         };
         let count = self.sampler.samples_per_pixel() as usize;
-        // The samples in order: sub-pixel by sub-pixel, each sub-pixel's `count` samples.
+        // The samples in order: pixel by pixel, sub-pixel by sub-pixel, each sub-pixel's `count`.
         scratch.points.clear();
-        for &(i, j, _) in subpixels {
-            let (sx, sy) = (scale * x + i, scale * y + j);
-            self.sampler.pixel(sx, sy).push_points(Vec2::new(sx as Real, sy as Real), &mut scratch.points);
-        }
-        self.trace_points(&scratch.points, (scale * width, scale * height), rays, &mut scratch.colors);
-        let mut color = M::zero();
-        for (colors, &(_, _, weight)) in scratch.colors.chunks_exact(count).zip(subpixels) {
-            let finished = M::of_samples(colors);
-            if scale == 1 {
-                color = finished;
-            } else {
-                color.add_weighted(&finished, weight);
+        for &(x, y) in coordinates {
+            for &(i, j, _) in subpixels {
+                let (sx, sy) = (scale * x + i, scale * y + j);
+                self.sampler.pixel(sx, sy).push_points(Vec2::new(sx as Real, sy as Real), &mut scratch.points);
             }
         }
-        color
+        self.trace_points(&scratch.points, (scale * width, scale * height), rays, &mut scratch.colors);
+        scratch.colors.chunks_exact(count * subpixels.len()).map(move |pixel| {
+            let mut color = M::zero();
+            for (colors, &(_, _, weight)) in pixel.chunks_exact(count).zip(subpixels) {
+                let finished = M::of_samples(colors);
+                if scale == 1 {
+                    color = finished;
+                } else {
+                    color.add_weighted(&finished, weight);
+                }
+            }
+            color
+        })
     }
 
     /// What the rays through the centres of up to eight pixels hit first (its `t` and shading
@@ -312,13 +327,19 @@ impl<F: FaultPolicy> PixelRenderer<'_, F> {
 }
 
 /// The centres of the pixels of `indices` (row-major in an image `width` pixels wide), at most
-/// eight; the lanes past them are left at zero.
+/// eight; the lanes past them are pixel `(0, 0)`'s.
 fn pixel_centres(indices: std::ops::Range<usize>, width: usize) -> [Vec2; LANES] {
-    let mut centres = [Vec2::ZERO; LANES];
-    for (centre, index) in centres.iter_mut().zip(indices) {
-        *centre = pixel_centre((index % width) as u32, (index / width) as u32);
+    pixel_coordinates(indices, width).map(|(x, y)| pixel_centre(x, y))
+}
+
+/// The column and row of each pixel of `indices` (row-major in an image `width` pixels wide),
+/// at most eight; the lanes past them are `(0, 0)`.
+fn pixel_coordinates(indices: std::ops::Range<usize>, width: usize) -> [(u32, u32); LANES] {
+    let mut coordinates = [(0, 0); LANES];
+    for (coordinate, index) in coordinates.iter_mut().zip(indices) {
+        *coordinate = ((index % width) as u32, (index / width) as u32);
     }
-    centres
+    coordinates
 }
 
 /// The centre of pixel `(x, y)` on the raster.
