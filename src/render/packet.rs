@@ -19,11 +19,11 @@ use crate::simd::{Isa, Kernel, Lanes, MaskOps, dispatch};
 use crate::stats::RayCounts;
 
 /// What up to eight primary rays saw.
-pub struct Traced {
-    pub color: [Color; LANES],
+struct Traced {
+    color: [Color; LANES],
     /// What each primary ray hit first (its `t` and shading normal), for the AOVs; all `None`
     /// unless asked for.
-    pub first: [Option<(Real, Vec3)>; LANES],
+    first: [Option<(Real, Vec3)>; LANES],
 }
 
 pub struct WhittedLanes<'a> {
@@ -60,50 +60,49 @@ impl<'a> WhittedLanes<'a> {
         WhittedLanes { scene, bounces, shadows, spawn, mirrors }
     }
 
-    /// The colour seen along the camera rays through one to eight points of the raster of an
-    /// image of `width × height`, and, when `first_hits`, what each ray hit first. The caller
-    /// counts the camera rays; the shadow and reflection rays are added to `rays`.
-    pub fn trace(&self, raster: &[Vec2], (width, height): (u32, u32), first_hits: bool, rays: &mut RayCounts) -> Traced {
-        struct Trace<'a, 'b>(&'a WhittedLanes<'a>, &'b [Vec2], (u32, u32), bool, &'b mut RayCounts);
-        impl Kernel for Trace<'_, '_> {
-            type Output = Traced;
-            #[inline(always)]
-            fn run<I: Isa>(self) -> Traced {
-                let (lanes, raster, (width, height), first_hits, rays) = (self.0, self.1, self.2, self.3, self.4);
-                let (x, y) = raster_lanes::<I>(raster);
-                let primaries = lanes.scene.camera.ray_lanes::<I>(x, y, width, height);
-                lanes.trace_lanes::<I>(primaries, raster.len(), first_hits, rays)
-            }
-        }
-        debug_assert!((1..=LANES).contains(&raster.len()));
-        dispatch(Trace(self, raster, (width, height), first_hits, rays))
-    }
-
     /// The colours seen along the camera rays through every point of `raster`, on the raster of
-    /// an image of `width × height`, appended to `colors` in order: [`WhittedLanes::trace`] eight
-    /// points at a time, in one call into the SIMD path for the lot, so that a pixel's samples
-    /// pay for the dispatch and for no [`Traced`] once per eight. The caller counts the camera
-    /// rays; the shadow and reflection rays are added to `rays`.
-    pub fn colors(&self, raster: &[Vec2], (width, height): (u32, u32), rays: &mut RayCounts, colors: &mut Vec<Color>) {
-        struct Colors<'a, 'b>(&'a WhittedLanes<'a>, &'b [Vec2], (u32, u32), &'b mut RayCounts, &'b mut Vec<Color>);
+    /// an image of `width × height`, appended to `colors` in order, and, when `firsts` is given,
+    /// what each ray hit first (its `t` and shading normal) appended to it. The points are traced
+    /// eight at a time in one call into the SIMD path for the lot, so that a run of pixels, or a
+    /// pixel's samples, pay for the dispatch once. The caller counts the camera rays; the shadow
+    /// and reflection rays are added to `rays`.
+    pub fn colors(
+        &self,
+        raster: &[Vec2],
+        (width, height): (u32, u32),
+        rays: &mut RayCounts,
+        colors: &mut Vec<Color>,
+        firsts: Option<&mut Vec<Option<(Real, Vec3)>>>,
+    ) {
+        struct Colors<'a, 'b> {
+            lanes: &'a WhittedLanes<'a>,
+            raster: &'b [Vec2],
+            size: (u32, u32),
+            rays: &'b mut RayCounts,
+            colors: &'b mut Vec<Color>,
+            firsts: Option<&'b mut Vec<Option<(Real, Vec3)>>>,
+        }
         impl Kernel for Colors<'_, '_> {
             type Output = ();
             #[inline(always)]
-            fn run<I: Isa>(self) {
-                let (lanes, raster, (width, height), rays, colors) = (self.0, self.1, self.2, self.3, self.4);
-                for batch in raster.chunks(LANES) {
+            fn run<I: Isa>(mut self) {
+                let (width, height) = self.size;
+                for batch in self.raster.chunks(LANES) {
                     let (x, y) = raster_lanes::<I>(batch);
-                    let primaries = lanes.scene.camera.ray_lanes::<I>(x, y, width, height);
-                    let traced = lanes.trace_lanes::<I>(primaries, batch.len(), false, rays);
-                    colors.extend_from_slice(&traced.color[..batch.len()]);
+                    let primaries = self.lanes.scene.camera.ray_lanes::<I>(x, y, width, height);
+                    let traced = self.lanes.trace_lanes::<I>(primaries, batch.len(), self.firsts.is_some(), self.rays);
+                    self.colors.extend_from_slice(&traced.color[..batch.len()]);
+                    if let Some(firsts) = self.firsts.as_deref_mut() {
+                        firsts.extend_from_slice(&traced.first[..batch.len()]);
+                    }
                 }
             }
         }
-        dispatch(Colors(self, raster, (width, height), rays, colors))
+        dispatch(Colors { lanes: self, raster, size: (width, height), rays, colors, firsts })
     }
 
     /// What the camera rays through one to eight points of the raster of an image of `width ×
-    /// height` hit first: each one's `t` and shading normal, as [`WhittedLanes::trace`] gives
+    /// height` hit first: each one's `t` and shading normal, as [`WhittedLanes::colors`] gives
     /// them, without shading anything. The caller counts the rays.
     pub fn first_hits(&self, raster: &[Vec2], (width, height): (u32, u32)) -> [Option<(Real, Vec3)>; LANES] {
         struct FirstHits<'a>(&'a Scene, &'a [Vec2], (u32, u32));

@@ -140,17 +140,19 @@ fn render_pixels<C: RayCounter, F: FaultPolicy, M: Moments>(
             let first = band_index * band;
             match pixels.runs() {
                 Some(lanes) => {
+                    // The whole band in one call into the SIMD path: a call costs far more than
+                    // its instructions (see `docs/speed.md`).
+                    let mut rays = RayCounts::default();
+                    let centres: Vec<Vec2> = (first..first + pixel_count)
+                        .map(|index| pixel_centre((index % width) as u32, (index / width) as u32))
+                        .collect();
+                    rays.camera += pixel_count as u64;
+                    let (mut colors, mut firsts) = (Vec::with_capacity(pixel_count), Vec::new());
                     let size = (options.trace.width, options.trace.height);
-                    for start in (0..pixel_count).step_by(LANES) {
-                        let end = (start + LANES).min(pixel_count);
-                        let mut rays = RayCounts::default();
-                        let centres = pixel_centres(first + start..first + end, width);
-                        rays.camera += (end - start) as u64;
-                        let traced = lanes.trace(&centres[..end - start], size, options.aovs, &mut rays);
-                        counter.add(&rays);
-                        for (k, offset) in (start..end).enumerate() {
-                            store(offset, Pixel::new(M::single(traced.color[k]), traced.first[k]));
-                        }
+                    lanes.colors(&centres, size, &mut rays, &mut colors, options.aovs.then_some(&mut firsts));
+                    counter.add(&rays);
+                    for (offset, &color) in colors.iter().enumerate() {
+                        store(offset, Pixel::new(M::single(color), firsts.get(offset).copied().flatten()));
                     }
                 }
                 None => {
@@ -311,7 +313,7 @@ impl<F: FaultPolicy> PixelRenderer<'_, F> {
             }
             return;
         };
-        lanes.colors(points, (width, height), rays, colors);
+        lanes.colors(points, (width, height), rays, colors, None);
     }
 
     /// The AOVs come from one ray through the output pixel's centre: depth and normals averaged
@@ -324,12 +326,6 @@ impl<F: FaultPolicy> PixelRenderer<'_, F> {
         let ray = self.scene.camera.ray(centre, self.options.trace.width, self.options.trace.height);
         faults::intersect(self.scene, &ray, self.faults)
     }
-}
-
-/// The centres of the pixels of `indices` (row-major in an image `width` pixels wide), at most
-/// eight; the lanes past them are pixel `(0, 0)`'s.
-fn pixel_centres(indices: std::ops::Range<usize>, width: usize) -> [Vec2; LANES] {
-    pixel_coordinates(indices, width).map(|(x, y)| pixel_centre(x, y))
 }
 
 /// The column and row of each pixel of `indices` (row-major in an image `width` pixels wide),
