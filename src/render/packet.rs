@@ -9,11 +9,15 @@
 //! that needs them. So the picture is bit-identical whichever integrator draws it, and the
 //! renderer uses this one for every render without the catalogue's integrator faults.
 
+use std::sync::atomic::{AtomicU8, Ordering};
+
+use rayon::prelude::*;
+
 use super::geometry::lanes::{LANES, Mask, RayLanes, V3, mask, set_lanes};
 use super::geometry::spawn::{spawn_lanes, spawn_to_lanes};
 use super::real::{Color, R8, Real, Vec2, Vec3};
 use super::scene::light::Light;
-use super::scene::{Background, HitLanes, Scene};
+use super::scene::{Background, CubeMap, HitLanes, Scene};
 use crate::options::Spawn;
 use crate::simd::{Isa, Kernel, Lanes, MaskOps, dispatch};
 use crate::stats::RayCounts;
@@ -26,6 +30,9 @@ struct Traced {
     first: [Option<(Real, Vec3)>; LANES],
 }
 
+/// Rays per work item of [`WhittedLanes::cube_map_faces_seen`].
+const PROBE_CHUNK: usize = 512;
+
 pub struct WhittedLanes<'a> {
     scene: &'a Scene,
     bounces: u32,
@@ -33,6 +40,11 @@ pub struct WhittedLanes<'a> {
     spawn: Spawn,
     /// Per material, whether its hits spawn a mirror ray under `spawn`'s rule.
     mirrors: Vec<bool>,
+    /// Whether rays that miss only note the cube-map faces they look at, in `faces_seen`, and
+    /// see black: a probe of which faces a render will decode
+    /// ([`WhittedLanes::cube_map_faces_seen`]).
+    probe: bool,
+    faces_seen: AtomicU8,
 }
 
 /// The materials of eight hits, lane by lane.
@@ -57,7 +69,19 @@ impl<'a> WhittedLanes<'a> {
                 _ => material.reflects(),
             })
             .collect();
-        WhittedLanes { scene, bounces, shadows, spawn, mirrors }
+        WhittedLanes { scene, bounces, shadows, spawn, mirrors, probe: false, faces_seen: AtomicU8::new(0) }
+    }
+
+    /// The cube-map faces that the camera rays through `raster` (on the raster of an image of
+    /// `width × height`) look at, on their way as [`WhittedLanes::colors`] traces them, as bits
+    /// (see [`CubeMap::faces_seen`]): without decoding any face, so that a render can decode
+    /// them side by side first. Nothing is counted and the colours are thrown away.
+    pub fn cube_map_faces_seen(&self, raster: &[Vec2], size: (u32, u32)) -> u8 {
+        let probe = WhittedLanes { mirrors: self.mirrors.clone(), probe: true, faces_seen: AtomicU8::new(0), ..*self };
+        raster.par_chunks(PROBE_CHUNK).for_each(|raster| {
+            probe.colors(raster, size, &mut RayCounts::default(), &mut Vec::with_capacity(raster.len()), None);
+        });
+        probe.faces_seen.into_inner()
     }
 
     /// The colours seen along the camera rays through every point of `raster`, on the raster of
@@ -191,6 +215,11 @@ impl<'a> WhittedLanes<'a> {
     fn background<I: Isa>(&self, rays: &RayLanes<I>, missed: u32) -> V3<I> {
         match &self.scene.background {
             Background::Color(color) => V3::splat(*color),
+            Background::CubeMap(_) if self.probe => {
+                let faces = CubeMap::faces_seen(&rays.direction.vectors(), missed);
+                self.faces_seen.fetch_or(faces, Ordering::Relaxed);
+                V3::splat(Color::ZERO)
+            }
             Background::CubeMap(map) => {
                 V3::gather(&map.radiance_lanes::<I, LANES>(&rays.direction.vectors(), missed))
             }

@@ -9,7 +9,7 @@ use super::integrator::Whitted;
 use super::packet::WhittedLanes;
 use super::real::{Color, Real, Vec2, Vec3, to_f32};
 use super::sampler::Sampler;
-use super::scene::{Intersection, Scene};
+use super::scene::{Background, CubeMap, Intersection, Scene};
 use crate::fault::{FaultPolicy, FaultSet, NoFaults};
 use super::moments::{MeanOnly, Moments, WithVariance, film_vector};
 use crate::film::Film;
@@ -119,6 +119,9 @@ fn render_pixels<C: RayCounter, F: FaultPolicy, M: Moments>(
         sampler,
         options,
     };
+    if let (Some(lanes), Background::CubeMap(map)) = (&pixels.lanes, &scene.background) {
+        decode_faces_in_view(lanes, map, options);
+    }
     let width = options.trace.width as usize;
     let band = width * BAND_ROWS;
     let bands: Vec<(C, M::Band)> = film
@@ -191,6 +194,29 @@ fn render_pixels<C: RayCounter, F: FaultPolicy, M: Moments>(
     }
     film.variance = M::assemble(variances);
     (film, counter)
+}
+
+/// Every how many pixels, across and down, [`decode_faces_in_view`] traces one: a face that
+/// covers a square this wide anywhere a ray reaches is found (under 2% of a one-sample render's
+/// rays); one seen only in smaller spots is decoded when first seen, as without the probe.
+const PROBE_SPACING: usize = 8;
+
+/// Decodes, side by side before the render, the cube-map faces that rays through a sparse grid
+/// of the picture's pixel centres look at (at any bounce), so that the faces the render will
+/// see are not decoded one after another by the first rays to look while others wait. The
+/// course's scene 7 sees two faces: both were decoded by one thread, in turn, each while the
+/// other thread waited. Changes no pixel: decoding is the same whenever it happens.
+fn decode_faces_in_view(lanes: &WhittedLanes<'_>, map: &CubeMap, options: &RenderOptions) {
+    let undecoded = map.undecoded_faces();
+    if undecoded == 0 {
+        return;
+    }
+    let (width, height) = (options.trace.width, options.trace.height);
+    let centres: Vec<Vec2> = (0..height as usize)
+        .step_by(PROBE_SPACING)
+        .flat_map(|y| (0..width as usize).step_by(PROBE_SPACING).map(move |x| pixel_centre(x as u32, y as u32)))
+        .collect();
+    map.decode_faces(lanes.cube_map_faces_seen(&centres, (width, height)) & undecoded);
 }
 
 /// A pixel's sample points and the colours seen through them, kept from pixel to pixel so that

@@ -93,23 +93,44 @@ impl CubeMap {
     /// Where `direction` looks: its face (an index into `faces`) and the texels it blends there,
     /// or `None` for a direction that is zero or not finite (which sees black).
     fn spot(&self, direction: Vec3) -> Option<(usize, Spot)> {
-        let d = direction.normalize_or_zero();
-        let (x, y, z) = (d.x, d.y, d.z);
-        let (ax, ay, az) = (x.abs(), y.abs(), z.abs());
-        let half = |a: Real, b: Real| (a / b + 1.0) * 0.5;
-        let (face, u, v) = if ax >= ay && ax >= az {
-            if x > 0.0 { (RIGHT, half(z, x), half(y, x)) } else { (LEFT, half(z, x), 1.0 - half(y, x)) }
-        } else if ay >= az {
-            if y > 0.0 { (UP, half(x, y), half(z, y)) } else { (DOWN, 1.0 - half(x, y), 1.0 - half(z, y)) }
-        } else if z > 0.0 {
-            (FRONT, 1.0 - half(x, z), half(y, z))
-        } else {
-            (BACK, half(x, z), 1.0 - half(y, z))
-        };
-        if !(u.is_finite() && v.is_finite()) {
-            return None;
-        }
+        let (face, u, v) = face_and_coordinates(direction)?;
         Some((face, self.faces[face].spot(u, v)))
+    }
+
+    /// The faces the directions whose bit is set in `wanted` look at, as bits (bit `i` for
+    /// `faces[i]`), without decoding any: which faces a lookup of each would decode.
+    pub fn faces_seen<const N: usize>(directions: &[Vec3; N], wanted: u32) -> u8 {
+        let mut faces = 0;
+        for (k, &direction) in directions.iter().enumerate() {
+            if wanted >> k & 1 != 0
+                && let Some((face, _, _)) = face_and_coordinates(direction)
+            {
+                faces |= 1 << face;
+            }
+        }
+        faces
+    }
+
+    /// The faces not decoded yet, as bits (see [`CubeMap::faces_seen`]).
+    pub fn undecoded_faces(&self) -> u8 {
+        let mut faces = 0;
+        for (index, face) in self.faces.iter().enumerate() {
+            if face.texels.get().is_none() {
+                faces |= 1 << index;
+            }
+        }
+        faces
+    }
+
+    /// Decodes the faces of `faces` (bits, see [`CubeMap::faces_seen`]) side by side, a thread
+    /// each. A render that knows which faces its rays will see decodes them so before it starts:
+    /// decoded when first seen, they are decoded one after another, each by the first ray to
+    /// look while any other ray that looks waits. A face that cannot be decoded is reported by
+    /// [`CubeMap::failure`] once a ray has looked at it, as when decoded on the way.
+    pub fn decode_faces(&self, faces: u8) {
+        self.faces.par_iter().enumerate().filter(|(index, _)| faces >> index & 1 != 0).for_each(|(_, face)| {
+            face.texels();
+        });
     }
 
     /// Decodes every face now instead of when first seen (for a scene rendered many times).
@@ -201,6 +222,25 @@ impl Face {
             + texel(2) * ((1.0 - alpha) * beta)
             + texel(3) * (alpha * beta)
     }
+}
+
+/// The face `direction` looks at (an index into [`CubeMap`]'s faces) and where on it, `(u, v)`
+/// in `[0, 1]`; `None` for a direction that is zero or not finite (which sees black).
+fn face_and_coordinates(direction: Vec3) -> Option<(usize, Real, Real)> {
+    let d = direction.normalize_or_zero();
+    let (x, y, z) = (d.x, d.y, d.z);
+    let (ax, ay, az) = (x.abs(), y.abs(), z.abs());
+    let half = |a: Real, b: Real| (a / b + 1.0) * 0.5;
+    let (face, u, v) = if ax >= ay && ax >= az {
+        if x > 0.0 { (RIGHT, half(z, x), half(y, x)) } else { (LEFT, half(z, x), 1.0 - half(y, x)) }
+    } else if ay >= az {
+        if y > 0.0 { (UP, half(x, y), half(z, y)) } else { (DOWN, 1.0 - half(x, y), 1.0 - half(z, y)) }
+    } else if z > 0.0 {
+        (FRONT, 1.0 - half(x, z), half(y, z))
+    } else {
+        (BACK, half(x, z), 1.0 - half(y, z))
+    };
+    (u.is_finite() && v.is_finite()).then_some((face, u, v))
 }
 
 /// Where a lookup reads on its face: the byte offsets of the four texels it blends (the texel
@@ -296,6 +336,47 @@ mod tests {
         assert_eq!(map.radiance(Vec3::new(0.5, 0.0, -1.0)).x, value(60));
         assert_eq!(map.radiance(Vec3::new(1.0, 1.0, 1.0)).x, value(10), "a three-way tie goes to x");
         assert_eq!(map.radiance(Vec3::new(0.0, -1.0, 1.0)).x, value(40), "a y–z tie goes to y");
+    }
+
+    #[test]
+    fn the_faces_seen_are_those_lookups_read_and_only_those_wanted() {
+        let map = cube([10, 20, 30, 40, 50, 60]);
+        let directions = [
+            Vec3::new(2.0, 1.0, 1.0),
+            Vec3::new(-2.0, 1.0, 1.0),
+            Vec3::new(0.0, 3.0, -1.0),
+            Vec3::ZERO,
+            Vec3::new(0.5, 0.0, -1.0),
+            Vec3::new(Real::NAN, 1.0, 0.0),
+            Vec3::new(1.0, 1.0, 1.0),
+            Vec3::new(0.0, -3.0, 1.0),
+        ];
+        let byte = |face: usize| [10, 20, 30, 40, 50, 60][face];
+        for k in 0..directions.len() {
+            let faces = CubeMap::faces_seen(&directions, 1 << k);
+            match map.spot(directions[k]) {
+                Some((face, _)) => {
+                    assert_eq!(faces, 1 << face, "direction {k}");
+                    assert_eq!(map.radiance(directions[k]).x, value(byte(face)), "direction {k}");
+                }
+                None => assert_eq!(faces, 0, "direction {k} sees black"),
+            }
+        }
+        assert_eq!(CubeMap::faces_seen(&directions, 0b1111_0111), 0b10_1111, "every face but front");
+        assert_eq!(CubeMap::faces_seen(&directions, 0b1000_0100), 0b00_1100, "up and down: wanted lanes only");
+    }
+
+    #[test]
+    fn decoding_faces_decodes_those_asked_for() {
+        let dir = faces_with_a_damaged_right_face(true);
+        let map = CubeMap::load(dir.path()).expect("the damage only shows when decoding");
+        assert_eq!(map.undecoded_faces(), 0b11_1111);
+        map.decode_faces(0b10_0010);
+        assert_eq!(map.undecoded_faces(), 0b01_1101);
+        assert!(map.failure().is_none(), "left and back decode");
+        map.decode_faces(0b00_0001);
+        assert_eq!(map.undecoded_faces(), 0b01_1100, "the damaged face counts as decoded");
+        assert!(map.failure().expect("right is damaged").path.ends_with("right.png"));
     }
 
     #[test]

@@ -81,3 +81,35 @@ fn every_spawn_rule_and_sampling_is_drawn_as_by_rays_traced_alone() {
         }
     }
 }
+
+/// The probe that decodes a render's cube-map faces before it starts finds, when it traces
+/// every pixel, exactly the faces that rendering decodes when they are first seen (by rays
+/// traced alone, so without the probe); and a render after the probe is the same picture.
+#[test]
+fn the_cube_map_probe_finds_the_faces_a_render_decodes() {
+    use super::super::packet::WhittedLanes;
+    use super::super::scene::Background;
+    use super::pixel_centre;
+    let cases = shipped_cases();
+    for name in ["course_scene06_bunny_1k", "course_scene07_arch"] {
+        let case = cases.iter().find(|case| case.name == name).unwrap_or_else(|| panic!("no case {name}"));
+        let options = small(case);
+        let cube_map = |scene: &super::Scene| match &scene.background {
+            Background::CubeMap(map) => map.undecoded_faces(),
+            Background::Color(_) => panic!("{name} has a cube map"),
+        };
+        let alone = build_scene(case).expect("builds");
+        let picture = render_one_ray_at_a_time(&alone, &options);
+        let decoded = !cube_map(&alone) & 0b11_1111;
+        assert!(decoded.count_ones() >= 2, "{name}: {decoded:06b}");
+
+        let probed = build_scene(case).expect("builds");
+        let (width, height) = (options.trace.width, options.trace.height);
+        let centres: Vec<_> = (0..height).flat_map(|y| (0..width).map(move |x| pixel_centre(x, y))).collect();
+        let trace = &options.trace;
+        let lanes = WhittedLanes::new(&probed, trace.bounces, trace.shadows, options.spawn);
+        assert_eq!(lanes.cube_map_faces_seen(&centres, (width, height)), decoded, "{name}");
+        assert_eq!(cube_map(&probed), 0b11_1111, "{name}: the probe decodes nothing");
+        assert_same_film(&render(&probed, &options, &Silent), &picture, name);
+    }
+}
