@@ -100,6 +100,8 @@ fn asks_for_course_help(args: &[std::ffi::OsString]) -> bool {
 ///   of kernel time to 1.9–2.6 s and from 4.7–5.0 s of wall time to 4.5–4.7 s (alternated on a
 ///   busy machine), with the same peak memory. The shared lock is taken only for blocks too large
 ///   for each thread's cache of small ones, a few per picture.
+/// - The heap grows in large steps, advised to use huge pages before blocks are carved from it
+///   (see `allocator::grow_heap_in_large_steps`).
 fn keep_freed_memory() {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
     // SAFETY: mallopt only sets allocator parameters; it is called before any thread starts.
@@ -108,6 +110,7 @@ fn keep_freed_memory() {
         libc::mallopt(libc::M_TRIM_THRESHOLD, 1 << 30);
         libc::mallopt(libc::M_ARENA_MAX, 1);
     }
+    crate::allocator::grow_heap_in_large_steps();
 }
 
 /// Parses the command line (rewriting the course's single-dash flags first), runs the command
