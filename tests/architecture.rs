@@ -59,12 +59,12 @@ fn source_files(dir: &Path, files: &mut Vec<PathBuf>) {
 }
 
 /// The top-level module a file belongs to (`src/grade/score.rs` → `grade`), or `None` for the
-/// binary (`main.rs`, `cli/`) and the crate root.
+/// binary (`main.rs`, `allocator.rs`, `cli/`) and the crate root.
 fn module_of(src: &Path, file: &Path) -> Option<String> {
     let relative = file.strip_prefix(src).expect("under src");
     let first = relative.components().next()?.as_os_str().to_string_lossy().into_owned();
     let name = first.trim_end_matches(".rs").to_owned();
-    (!matches!(name.as_str(), "main" | "cli" | "lib")).then_some(name)
+    (!matches!(name.as_str(), "main" | "allocator" | "cli" | "lib")).then_some(name)
 }
 
 /// Code lines only: comment lines would name modules without depending on them.
