@@ -12,6 +12,10 @@
 //! (`/sys/kernel/mm/transparent_hugepage/enabled`): with `never` the advice changes nothing.
 //! Only whole huge pages inside a block are advised, so no other block shares one.
 
+// The heap's advice needs glibc's heap; elsewhere only blocks are advised and the heap's part
+// is compiled but unused.
+#![cfg_attr(not(all(target_os = "linux", target_env = "gnu")), allow(dead_code, unused_imports))]
+
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
