@@ -135,9 +135,7 @@ impl CubeMap {
 
     /// Decodes every face now instead of when first seen (for a scene rendered many times).
     pub fn decode_all(&self) -> Result<(), CubeMapError> {
-        self.faces.par_iter().for_each(|face| {
-            face.texels();
-        });
+        self.decode_faces(u8::MAX);
         self.failure().map_or(Ok(()), Err)
     }
 
