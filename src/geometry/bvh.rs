@@ -41,13 +41,6 @@ const BOX_SLACK: Real = 1.0 + 64.0 * MACHINE_EPSILON;
 /// Most primitives a BVH holds: the binary tree's `2n − 1` node slots are numbered with `u32`.
 pub const MAX_PRIMITIVES: usize = 1 << 31;
 
-/// Deepest binary tree [`Bvh::build`] can produce: SAH splits are allowed up to
-/// `build::SAH_DEPTH_LIMIT` levels, after which median splits at most halve `u32::MAX` primitives
-/// down to a leaf. The wide tree is no deeper, and each node visited pushes at most `WIDTH − 1`
-/// children (the nearest is visited next), which sizes the traversal stack so that it can never
-/// overflow.
-const STACK_SIZE: usize = (WIDTH - 1) * (build::SAH_DEPTH_LIMIT + 33) + 1;
-
 /// A child waiting on the traversal stack: `count == 0` for a node, else a leaf's run of
 /// primitives; `t` is where the ray enters its box, so that it is skipped once a hit nearer
 /// than that is known.

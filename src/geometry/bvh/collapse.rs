@@ -7,7 +7,7 @@
 //! same primitives; children keep their left-to-right order. A pure function of the binary
 //! tree, so the wide tree is as deterministic as the binary one.
 
-use super::build::BinaryNode;
+use super::build::{BinaryNode, SAH_DEPTH_LIMIT};
 use super::node::{BvhNode, Child};
 use super::WIDTH;
 use super::super::huge_page_vec;
@@ -60,7 +60,28 @@ pub(super) fn collapse_in_parallel_to(binary: &[BinaryNode], parallel_depth: usi
         });
         BvhNode::new(&children[..entry.len as usize])
     }));
+    set_heights(&mut nodes);
     nodes
+}
+
+/// Heights fit a node's byte: SAH splits are allowed up to `SAH_DEPTH_LIMIT` levels, after
+/// which median splits at most halve `u32::MAX` primitives down to a leaf, and the wide tree is
+/// no deeper than the binary one.
+const _: () = assert!(SAH_DEPTH_LIMIT + 33 <= u8::MAX as usize);
+
+/// Gives each node the height of its subtree: nodes are laid out depth first, each after its
+/// parent, so going from the last node to the first meets every child before its parent.
+fn set_heights(nodes: &mut [BvhNode]) {
+    for index in (0..nodes.len()).rev() {
+        let node = &nodes[index];
+        let mut height = 1u8;
+        for lane in 0..WIDTH {
+            if node.used() >> lane & 1 != 0 && node.count[lane] == 0 {
+                height = height.max(nodes[node.child[lane] as usize].height.saturating_add(1));
+            }
+        }
+        nodes[index].height = height;
+    }
 }
 
 /// One wide node as laid out: the binary nodes that are its children, in order, how many there

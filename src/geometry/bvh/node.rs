@@ -46,6 +46,9 @@ pub struct BvhNode {
     pub(super) count: [u8; WIDTH],
     /// A bit per slot that holds a child whose box is not empty.
     used: u8,
+    /// Levels of nodes in the subtree this node heads, itself included (1 when every child is
+    /// a leaf): the root's sizes a traversal's stack (see `traverse::StackSpace`).
+    pub(super) height: u8,
 }
 
 /// A child as the collapse hands it to [`BvhNode::new`]: its exact box, its node or first
@@ -72,6 +75,7 @@ impl BvhNode {
             child: [0; WIDTH],
             count: [0; WIDTH],
             used: 0,
+            height: 1,
         };
         for (lane, child) in children.iter().enumerate() {
             node.child[lane] = child.index;

@@ -4,7 +4,7 @@ use super::super::Ray;
 use super::super::real::{R8, Real};
 use crate::simd::{Isa, Lanes, MaskOps};
 use super::*;
-use super::traverse::{Stack, sort_key, stack_space};
+use super::traverse::{StackSpace, sort_key};
 
 pub const PACKET: usize = 8;
 
@@ -85,8 +85,8 @@ pub fn traverse_packet<I: Isa>(
     if nodes.is_empty() || rays == 0 {
         return;
     }
-    let mut space = stack_space();
-    let mut stack = Stack::<PacketPending>::new(&mut space);
+    let mut space = StackSpace::<PacketPending>::new();
+    let mut stack = space.stack(nodes);
     let mut current = PacketPending { t: 0.0, index: 0, count: 0, rays };
     loop {
         if current.count == 0 {

@@ -341,3 +341,83 @@ fn a_packet_reaches_every_leaf_its_rays_reach_alone() {
         }
     }
 }
+
+/// Every primitive's leaf `(first, count)` as each traversal reaches them: one ray alone, the
+/// rays interleaved, and the rays as a packet.
+struct EveryTraversal<'a> {
+    nodes: &'a [BvhNode],
+    rays: &'a [Ray],
+}
+
+impl Kernel for EveryTraversal<'_> {
+    type Output = [Vec<(u32, u32)>; 3];
+    fn run<I: Isa>(self) -> Self::Output {
+        let mut alone = Vec::new();
+        let mut visit = VisitFn(|first, count, _: &mut Real| {
+            alone.push((first, count));
+            Visit::Continue
+        });
+        traverse::<I>(self.nodes, &self.rays[0], Real::INFINITY, &mut visit);
+        let mut logs = vec![Vec::new(); self.rays.len()];
+        let mut visitors: Vec<_> = logs
+            .iter_mut()
+            .map(|log| {
+                VisitFn(move |first, count, _: &mut Real| {
+                    log.push((first, count));
+                    Visit::Continue
+                })
+            })
+            .collect();
+        traverse_interleaved::<I, _>(self.nodes, self.rays, &[Real::INFINITY; PACKET], &mut visitors);
+        drop(visitors);
+        let interleaved = logs.pop().expect("rays");
+        let lanes = PacketLanes::<I>::new(self.rays).expect("rays that make a packet");
+        let mut packet = PacketLog(Vec::new());
+        traverse_packet::<I>(self.nodes, &lanes, (1 << self.rays.len()) - 1, &mut [Real::INFINITY; PACKET], &mut packet);
+        let packet = packet.0.iter().filter(|&&(lane, ..)| lane == 0).map(|&(_, first, count)| (first, count)).collect();
+        [alone, interleaved, packet]
+    }
+}
+
+/// Appends, depth first, a binary tree of `levels` levels down a spine: each interior node's
+/// first child holds two leaves in the far half of the unit cube, its second continues the
+/// spine, which ends in a leaf filling the cube. A ray from below the cube's near corner enters
+/// the spine's boxes first, so the traversal goes down the spine with the leaves waiting.
+fn spine(nodes: &mut Vec<build::BinaryNode>, levels: usize, leaves: &mut Vec<(u32, u32)>) {
+    let (cube, far_half) = (Aabb::new(Vec3::ZERO, Vec3::ONE), Aabb::new(Vec3::splat(0.5), Vec3::ONE));
+    let mut leaf = |nodes: &mut Vec<build::BinaryNode>, bounds: Aabb| {
+        let first = leaves.len() as u32;
+        leaves.push((first, 1));
+        nodes.push(build::BinaryNode { bounds, area: bounds.surface_area(), offset: first, prim_count: 1 });
+    };
+    if levels == 0 {
+        return leaf(nodes, cube);
+    }
+    let interior = |bounds: Aabb| build::BinaryNode { bounds, area: bounds.surface_area(), offset: 0, prim_count: 0 };
+    let at = nodes.len();
+    nodes.extend([interior(cube), interior(far_half)]);
+    leaf(nodes, far_half);
+    nodes[at + 1].offset = nodes.len() as u32;
+    leaf(nodes, far_half);
+    nodes[at].offset = nodes.len() as u32;
+    spine(nodes, levels - 1, leaves);
+}
+
+#[test]
+fn trees_too_tall_for_a_stack_in_the_frame_are_traversed_whole() {
+    // The collapse expands the spine, the larger box, first: each wide node takes seven of
+    // its levels and pushes seven pairs of leaves on the stack on the way down.
+    let (mut binary, mut leaves) = (Vec::new(), Vec::new());
+    spine(&mut binary, 200, &mut leaves);
+    let nodes = collapse::collapse_in_parallel_to(&binary, 0);
+    let height = nodes[0].height as usize;
+    assert!(height > 2 * traverse::LOCAL_HEIGHT, "a tree of {height} levels");
+    let rays = [Ray::new(Vec3::splat(-1.0), Vec3::new(1.0, 0.9, 0.8).normalize()); 2];
+    for path in crate::simd::available() {
+        for mut reached in crate::simd::dispatch_on(path, EveryTraversal { nodes: &nodes, rays: &rays }).unwrap() {
+            reached.sort_unstable();
+            assert_eq!(reached, leaves, "{path:?}");
+        }
+    }
+}
+

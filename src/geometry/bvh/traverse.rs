@@ -100,33 +100,58 @@ pub(super) fn sort_key(t: Real, lane: usize) -> u64 {
     key | lane as u64
 }
 
-/// Room for a traversal stack's entries: `STACK_SIZE`, the most any tree can need, and, unlike
-/// an array of entries, not initialised (zeroing them for every ray would cost more than most
-/// rays push; a `Vec` would cost an allocation).
-pub(super) type StackSpace<T> = [MaybeUninit<T>; STACK_SIZE];
+/// Levels of tree whose traversals keep their stacks in their own frame: deeper trees (which
+/// only the median splits past `build::SAH_DEPTH_LIMIT` make) take theirs from the heap. A
+/// frame holds eight stacks for interleaved rays, and every page of it is touched on each call.
+pub(super) const LOCAL_HEIGHT: usize = 12;
 
-/// An uninitialised [`StackSpace`].
-#[inline(always)]
-pub(super) const fn stack_space<T>() -> StackSpace<T> {
-    [const { MaybeUninit::uninit() }; STACK_SIZE]
+/// A stack's entries in the traversal's frame: each node visited pushes at most `WIDTH − 1`
+/// children (the nearest is visited next), and what a node pushed is popped before the
+/// traversal leaves its subtree, so a tree of `h` levels never has more than `(WIDTH − 1)·h`
+/// entries waiting, plus the one being pushed.
+const LOCAL_ENTRIES: usize = (WIDTH - 1) * LOCAL_HEIGHT + 1;
+
+/// Room for a traversal stack's entries: in the frame for trees of up to [`LOCAL_HEIGHT`]
+/// levels, else on the heap, sized by the tree's height. Not initialised (zeroing the entries
+/// for every ray would cost more than most rays push).
+pub(super) struct StackSpace<T> {
+    local: [MaybeUninit<T>; LOCAL_ENTRIES],
+    heap: Vec<MaybeUninit<T>>,
+}
+
+impl<T> StackSpace<T> {
+    #[inline(always)]
+    pub(super) const fn new() -> Self {
+        // SAFETY: an array of `MaybeUninit` needs no initialisation.
+        StackSpace { local: unsafe { MaybeUninit::uninit().assume_init() }, heap: Vec::new() }
+    }
+
+    /// An empty stack with room for any traversal of the tree `nodes` (root first).
+    #[inline(always)]
+    pub(super) fn stack(&mut self, nodes: &[BvhNode]) -> Stack<'_, T> {
+        let height = nodes.first().map_or(0, |root| root.height as usize);
+        let entries = if height <= LOCAL_HEIGHT {
+            &mut self.local[..]
+        } else {
+            self.heap.resize_with((WIDTH - 1) * height + 1, MaybeUninit::uninit);
+            &mut self.heap[..]
+        };
+        Stack { entries, len: 0 }
+    }
 }
 
 /// A traversal stack in a [`StackSpace`] of the caller's, so that the stack itself is small
-/// enough to move. A push never checks for room and a pop only for emptiness.
+/// enough to move. A push checks for room only as slice indexing does (the room is there, see
+/// [`LOCAL_ENTRIES`]) and a pop only for emptiness.
 pub(super) struct Stack<'a, T> {
-    entries: &'a mut StackSpace<T>,
+    entries: &'a mut [MaybeUninit<T>],
     len: usize,
 }
 
 impl<'a, T: Copy> Stack<'a, T> {
     #[inline(always)]
-    pub(super) fn new(space: &'a mut StackSpace<T>) -> Self {
-        Stack { entries: space, len: 0 }
-    }
-
-    #[inline(always)]
     pub(super) fn push(&mut self, entry: T) {
-        // In bounds: each node visited pushes at most `WIDTH - 1` entries (see `STACK_SIZE`).
+        // In bounds: each node visited pushes at most `WIDTH - 1` entries (see `LOCAL_ENTRIES`).
         self.entries[self.len] = MaybeUninit::new(entry);
         self.len += 1;
     }
@@ -165,7 +190,7 @@ fn fetch<I: Isa>(nodes: &[BvhNode], pending: &Pending, visitor: &impl LeafVisito
 /// A kernel: compile it only inside one (see `crate::simd`).
 #[inline(always)]
 pub fn traverse<I: Isa>(nodes: &[BvhNode], ray: &Ray, t_max: Real, visitor: &mut impl LeafVisitor<I>) {
-    let mut space = stack_space();
+    let mut space = StackSpace::new();
     let Some(mut walk) = Walk::<I>::new(nodes, ray, t_max, &mut space) else { return };
     while walk.step::<false>(nodes, visitor) {}
 }
@@ -190,9 +215,7 @@ pub fn traverse_interleaved<I: Isa, V: LeafVisitor<I>>(
     visitors: &mut [V],
 ) {
     assert!(rays.len() <= PACKET && visitors.len() >= rays.len(), "up to {PACKET} rays, a visitor each");
-    // SAFETY: an array of `MaybeUninit` needs no initialisation (a repeated `stack_space()`
-    // would be written out with zeros).
-    let mut spaces: [StackSpace<Pending>; PACKET] = unsafe { MaybeUninit::uninit().assume_init() };
+    let mut spaces = [const { StackSpace::<Pending>::new() }; PACKET];
     let mut walks = [const { None }; PACKET];
     let mut active = 0u32;
     // Loops rather than `array::from_fn`: a closure may be compiled outside the kernel,
@@ -234,7 +257,7 @@ impl<'a, I: Isa> Walk<'a, I> {
             slab: SlabLanes::<I>::new(ray),
             t_limit: t_max,
             current: Pending { t: 0.0, index: 0, count: 0 },
-            stack: Stack::new(space),
+            stack: space.stack(nodes),
         })
     }
 
