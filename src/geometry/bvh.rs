@@ -85,6 +85,10 @@ impl<I: Isa, F: FnMut(u32, u32, &mut Real) -> Visit> LeafVisitor<I> for VisitFn<
 /// `#[inline(always)]`.
 pub trait PacketVisitor<I: Isa> {
     fn leaf(&mut self, first: u32, count: u32, rays: u32, t_limit: &mut [Real; PACKET]);
+
+    /// As [`LeafVisitor::prefetch`]: a leaf was put on the stack (a hint that changes nothing).
+    #[inline(always)]
+    fn prefetch(&self, _first: u32, _count: u32) {}
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -202,6 +202,33 @@ pub struct RayLanes<I: Isa> {
 }
 
 impl<I: Isa> RayLanes<I> {
+    /// `rays[lane]` in each lane; lanes past the end repeat the last ray.
+    ///
+    /// # Panics
+    /// If `rays` is empty.
+    #[inline(always)]
+    pub fn gather(rays: &[Ray]) -> Self {
+        let mut axes = [[[0.0; LANES]; 3]; 2];
+        for lane in 0..LANES {
+            let ray = &rays[lane.min(rays.len() - 1)];
+            let (o, d) = (ray.origin, ray.direction);
+            (axes[0][0][lane], axes[0][1][lane], axes[0][2][lane]) = (o.x, o.y, o.z);
+            (axes[1][0][lane], axes[1][1][lane], axes[1][2][lane]) = (d.x, d.y, d.z);
+        }
+        RayLanes { origin: V3::load(&axes[0]), direction: V3::load(&axes[1]) }
+    }
+
+    /// A bit per lane whose origin and direction are finite.
+    #[inline(always)]
+    pub fn finite(&self) -> u32 {
+        let infinity = R8::<I>::splat(Real::INFINITY);
+        let mut finite = 0xff;
+        for v in [self.origin.x, self.origin.y, self.origin.z, self.direction.x, self.direction.y, self.direction.z] {
+            finite &= v.abs().lt(infinity).bits();
+        }
+        finite
+    }
+
     #[inline(always)]
     pub fn at(&self, t: R8<I>) -> V3<I> {
         self.origin + self.direction.scale(t)

@@ -1,12 +1,14 @@
 //! Packets of up to eight coherent rays traversing the tree together.
 
 use super::super::Ray;
+use super::super::lanes::RayLanes;
 use super::super::real::{R8, Real};
 use crate::simd::{Isa, Lanes, MaskOps};
 use super::*;
 use super::traverse::{StackSpace, sort_key};
 
 pub const PACKET: usize = 8;
+
 
 /// The per-ray part of the slab test for a packet of up to eight rays, one per lane, which
 /// share the signs of their directions.
@@ -15,9 +17,97 @@ pub struct PacketLanes<I: Isa> {
     inverse: [R8<I>; 3],
     far_inverse: [R8<I>; 3],
     negative: [bool; 3],
+    /// The rays' ranges, when every inverse is finite (see [`Frustum`]).
+    frustum: Option<Frustum>,
+}
+
+/// The range of each of the packet's slab terms over its rays, for a test of a node's eight
+/// boxes at once against the whole packet before each box is tested against each ray. The test
+/// is interval arithmetic over the per-ray test's own roundings: a rounded subtraction or
+/// product moves monotonically with each operand, so the per-ray entry distance of every ray is
+/// no nearer than the range's nearest and its exit no farther than the range's farthest. A box
+/// that no ray can enter by that bound is one that no ray enters by its own test: the pre-test
+/// only spares tests whose answer is "no", and changes no result.
+///
+/// Not made when a direction component is zero: its infinite inverse times a plane through the
+/// origin is NaN, which the per-ray test reads as "no constraint" on that ray alone.
+/// Kept as numbers, splatted where used: lanes of them would be copied with the packet.
+#[derive(Clone, Copy)]
+struct Frustum {
+    /// Per axis: the smallest and largest origin component.
+    origin: [[Real; 2]; 3],
+    /// Per axis: the smallest and largest inverse, and the same of the widened far inverse.
+    inverse: [[Real; 2]; 3],
+    far_inverse: [[Real; 2]; 3],
+}
+
+impl Frustum {
+    /// From the packet's lanes; `None` when an inverse is not finite.
+    #[inline(always)]
+    fn new<I: Isa>(origin: &[R8<I>; 3], inverse: &[R8<I>; 3]) -> Option<Self> {
+        let infinity = R8::<I>::splat(Real::INFINITY);
+        // The far inverse is the inverse times a positive constant, and a rounded product
+        // moves with its operand: its range is its ends' products.
+        let widen = 1.0 + 2.0 * gamma(3);
+        let mut frustum = Frustum { origin: [[0.0; 2]; 3], inverse: [[0.0; 2]; 3], far_inverse: [[0.0; 2]; 3] };
+        for axis in 0..3 {
+            if inverse[axis].abs().lt(infinity).bits() != 0xff {
+                return None;
+            }
+            frustum.origin[axis] = range::<I>(origin[axis]);
+            let [low, high] = range::<I>(inverse[axis]);
+            frustum.inverse[axis] = [low, high];
+            frustum.far_inverse[axis] = [low * widen, high * widen];
+        }
+        Some(frustum)
+    }
+
+    /// A bit per box (lane) that some ray of the packet may enter for a `t` up to `t_max`,
+    /// a superset of the boxes the per-ray test finds entered by any ray whose limit is at
+    /// most `t_max`, and per box a distance no farther than any ray's entry (non-negative,
+    /// never NaN). `planes[side][axis]` are the boxes' planes, as the per-ray test reads them,
+    /// and `negative` the packet's direction signs.
+    #[inline(always)]
+    fn may_enter<I: Isa>(&self, planes: &[[R8<I>; 3]; 2], negative: [bool; 3], t_max: Real) -> (R8<I>, u32) {
+        let splat = R8::<I>::splat;
+        let mut t_enter = splat(0.0);
+        let mut t_exit = splat(t_max);
+        for axis in 0..3 {
+            let negative = negative[axis] as usize;
+            let (near, far) = (planes[negative][axis], planes[1 - negative][axis]);
+            let [origin_low, origin_high] = self.origin[axis];
+            // The product of a positive inverse grows with the difference, of a negative one
+            // shrinks: the nearest entry takes the smallest difference then, else the largest,
+            // and the farthest exit the other; either end of the inverse's range may give it.
+            let (near_end, far_end) = if negative == 0 {
+                (near - splat(origin_high), far - splat(origin_low))
+            } else {
+                (near - splat(origin_low), far - splat(origin_high))
+            };
+            let [inverse_low, inverse_high] = self.inverse[axis];
+            let [far_low, far_high] = self.far_inverse[axis];
+            let t_near = (near_end * splat(inverse_low)).min(near_end * splat(inverse_high));
+            let t_far = (far_end * splat(far_low)).max(far_end * splat(far_high));
+            t_enter = t_near.max(t_enter);
+            t_exit = t_far.min(t_exit);
+        }
+        (t_enter, t_enter.le(t_exit).bits())
+    }
 }
 
 impl<I: Isa> PacketLanes<I> {
+    /// The packet's test of eight boxes at once ([`Frustum`]), when it has one: a bit per box
+    /// that some ray may enter for a `t` up to `reach` (a superset of those the rays enter each
+    /// by its own test) and per box a distance no farther than any ray's entry.
+    /// `planes[side][axis]` are the boxes' planes, as the per-ray test reads them.
+    #[inline(always)]
+    pub(super) fn may_enter(&self, planes: &[[R8<I>; 3]; 2], reach: Real) -> Option<(R8<I>, u32)> {
+        match &self.frustum {
+            Some(frustum) => Some(frustum.may_enter::<I>(planes, self.negative, reach)),
+            None => None,
+        }
+    }
+
     /// `None` unless there are one to eight rays, all finite, whose direction components share
     /// their signs (as camera rays through a small tile do). Lanes past the last ray repeat it.
     #[inline(always)]
@@ -25,37 +115,42 @@ impl<I: Isa> PacketLanes<I> {
         if rays.is_empty() || rays.len() > PACKET {
             return None;
         }
-        let mut values = [[0.0; PACKET]; 9];
-        let mut signs = None;
-        for lane in 0..PACKET {
-            let ray = &rays[lane.min(rays.len() - 1)];
-            if !(ray.origin.is_finite() && ray.direction.is_finite()) {
-                return None;
-            }
-            let inverse = ray.direction.recip();
-            let negative = [inverse.x < 0.0, inverse.y < 0.0, inverse.z < 0.0];
-            if *signs.get_or_insert(negative) != negative {
-                return None;
-            }
-            // As `SlabLanes::new` computes them for one ray.
-            let far_inverse = inverse * (1.0 + 2.0 * gamma(3));
-            let (o, i, f) = (ray.origin, inverse, far_inverse);
-            for (k, value) in [o.x, o.y, o.z, i.x, i.y, i.z, f.x, f.y, f.z].into_iter().enumerate() {
-                values[k][lane] = value;
+        PacketLanes::from_lanes(&RayLanes::gather(rays))
+    }
+
+    /// [`PacketLanes::new`] of rays already side by side: `None` unless every lane is finite
+    /// and the lanes' direction components share their signs.
+    #[inline(always)]
+    pub fn from_lanes(rays: &RayLanes<I>) -> Option<Self> {
+        if rays.finite() != 0xff {
+            return None;
+        }
+        // As `SlabLanes::new` computes them for one ray, a lane at a time.
+        let one = R8::<I>::splat(1.0);
+        let (o, d) = (rays.origin, rays.direction);
+        let inverse = [one / d.x, one / d.y, one / d.z];
+        let widen = R8::<I>::splat(1.0 + 2.0 * gamma(3));
+        let mut negative = [false; 3];
+        for (negative, inverse) in negative.iter_mut().zip(&inverse) {
+            match inverse.lt(R8::<I>::splat(0.0)).bits() {
+                0 => {}
+                0xff => *negative = true,
+                _ => return None,
             }
         }
-        let v = &values;
+        let origin = [o.x, o.y, o.z];
         Some(PacketLanes {
-            origin: [R8::<I>::load(&v[0]), R8::<I>::load(&v[1]), R8::<I>::load(&v[2])],
-            inverse: [R8::<I>::load(&v[3]), R8::<I>::load(&v[4]), R8::<I>::load(&v[5])],
-            far_inverse: [R8::<I>::load(&v[6]), R8::<I>::load(&v[7]), R8::<I>::load(&v[8])],
-            negative: signs.expect("at least one ray"),
+            origin,
+            inverse,
+            far_inverse: [inverse[0] * widen, inverse[1] * widen, inverse[2] * widen],
+            negative,
+            frustum: Frustum::new::<I>(&origin, &inverse),
         })
     }
 }
 
 /// A child waiting on a packet's stack: a [`Pending`] and the rays (a bit per lane) that entered
-/// its box, the nearest at `t`.
+/// its box, none of them nearer than `t`.
 #[derive(Clone, Copy)]
 struct PacketPending {
     t: Real,
@@ -67,7 +162,9 @@ struct PacketPending {
 /// [`traverse`] for a packet of rays, each node visited once for all the rays that enter it:
 /// each child box is tested against every ray at once (a ray per lane), with the same slab test
 /// as one ray's traversal, so each ray enters exactly the boxes it would enter alone (given its
-/// own `t_limit`). Children are visited nearest first (by the nearest ray's entry). `visit(first,
+/// own `t_limit`). Children are visited nearest first (by the nearest ray's entry, or the packet's
+/// frustum's bound on it). Boxes that no ray of the packet can enter by the frustum's test are
+/// not tested ray by ray; children waiting are fetched from memory meanwhile. `visit(first,
 /// count, rays, t_limit)` is called for each leaf with the rays (bits) that reached it; it may
 /// shrink the rays' entries of `t_limit`, which prunes, ray by ray, every box entered beyond.
 ///
@@ -88,6 +185,8 @@ pub fn traverse_packet<I: Isa>(
     let mut space = StackSpace::<PacketPending>::new();
     let mut stack = space.stack(nodes);
     let mut current = PacketPending { t: 0.0, index: 0, count: 0, rays };
+    // The farthest any ray may still reach, for the frustum's test; it changes only at leaves.
+    let mut reach = max_lane::<I>(R8::<I>::load(&t_limit[..]) * R8::<I>::splat(BOX_SLACK));
     loop {
         if current.count == 0 {
             let node = &nodes[current.index as usize];
@@ -95,13 +194,22 @@ pub fn traverse_packet<I: Isa>(
             let mut children = [(0u64, 0u32); WIDTH];
             let mut hit = 0;
             // The node's planes, as one ray's traversal computes them, then lane by lane.
+            let mut plane_lanes = [[R8::<I>::splat(0.0); 3]; 2];
             let mut planes = [[[0.0; WIDTH]; 3]; 2];
-            for (side, planes) in planes.iter_mut().enumerate() {
-                for (axis, planes) in planes.iter_mut().enumerate() {
-                    node.planes::<I>(side, axis).store(planes);
+            for side in 0..2 {
+                for axis in 0..3 {
+                    plane_lanes[side][axis] = node.planes::<I>(side, axis);
+                    plane_lanes[side][axis].store(&mut planes[side][axis]);
                 }
             }
             let mut used = node.used();
+            // With a frustum, the boxes are ordered by its entry distances, each no farther
+            // than the nearest ray's (the order only decides how soon a box is visited).
+            let mut frustum_entry = [Real::NAN; WIDTH];
+            if let Some((t_enter, may_enter)) = lanes.may_enter(&plane_lanes, reach) {
+                t_enter.store(&mut frustum_entry);
+                used &= may_enter;
+            }
             while used != 0 {
                 let slot = used.trailing_zeros() as usize;
                 used &= used - 1;
@@ -120,9 +228,12 @@ pub fn traverse_packet<I: Isa>(
                 let any_ray = entered_lanes.bits();
                 let entered = any_ray & current.rays;
                 if entered != 0 {
-                    // Usually every ray that enters the box is one of the current rays, and the
-                    // nearest entry is one select and a tree of minimums; else lane by lane.
-                    let nearest = if entered == any_ray {
+                    let nearest = if lanes.frustum.is_some() {
+                        frustum_entry[slot]
+                    } else if entered == any_ray {
+                        // Usually every ray that enters the box is one of the current rays, and
+                        // the nearest entry is one select and a tree of minimums; else lane by
+                        // lane.
                         min_lane::<I>(R8::<I>::select(entered_lanes, t_enter, R8::<I>::splat(Real::INFINITY)))
                     } else {
                         let mut t = [0.0; PACKET];
@@ -154,13 +265,16 @@ pub fn traverse_packet<I: Isa>(
                     PacketPending { t, index: node.child[slot], count: node.count[slot] as u32, rays }
                 };
                 for &child in children[1..hit].iter().rev() {
-                    stack.push(pending(child));
+                    let waiting = pending(child);
+                    fetch::<I>(nodes, &waiting, visitor);
+                    stack.push(waiting);
                 }
                 current = pending(children[0]);
                 continue;
             }
         } else {
             visitor.leaf(current.index, current.count, current.rays, t_limit);
+            reach = max_lane::<I>(R8::<I>::load(&t_limit[..]) * R8::<I>::splat(BOX_SLACK));
         }
         loop {
             let Some(pending) = stack.pop() else { return };
@@ -173,6 +287,41 @@ pub fn traverse_packet<I: Isa>(
             }
         }
     }
+}
+
+/// A child that waits on the stack is fetched from memory meanwhile: a node here, a leaf's
+/// primitives by the visitor.
+#[inline(always)]
+fn fetch<I: Isa>(nodes: &[BvhNode], pending: &PacketPending, visitor: &impl PacketVisitor<I>) {
+    if pending.count == 0 {
+        let waiting: *const BvhNode = &nodes[pending.index as usize];
+        for line in 0..size_of::<BvhNode>().div_ceil(64) {
+            I::prefetch(waiting.cast::<u8>().wrapping_add(64 * line));
+        }
+    } else {
+        visitor.prefetch(pending.index, pending.count);
+    }
+}
+
+/// The smallest and largest lane (none being NaN).
+#[inline(always)]
+fn range<I: Isa>(lanes: R8<I>) -> [Real; 2] {
+    let mut values = [0.0; PACKET];
+    lanes.store(&mut values);
+    let (mut low, mut high) = (values[0], values[0]);
+    for &value in &values[1..] {
+        (low, high) = (low.min(value), high.max(value));
+    }
+    [low, high]
+}
+
+/// The largest lane (none being NaN), by a tree of maximums over the stored lanes.
+#[inline(always)]
+fn max_lane<I: Isa>(lanes: R8<I>) -> Real {
+    let mut t = [0.0; PACKET];
+    lanes.store(&mut t);
+    let pairs = [t[0].max(t[4]), t[1].max(t[5]), t[2].max(t[6]), t[3].max(t[7])];
+    pairs[0].max(pairs[2]).max(pairs[1].max(pairs[3]))
 }
 
 /// The smallest lane (none being NaN), by a tree of minimums over the stored lanes.

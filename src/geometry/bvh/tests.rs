@@ -1,5 +1,6 @@
 use super::*;
-use super::super::real::Vec3;
+use super::super::real::{R8, Vec3};
+use crate::simd::Lanes;
 
 fn point_boxes(points: &[Vec3]) -> Vec<Aabb> {
     points
@@ -421,3 +422,83 @@ fn trees_too_tall_for_a_stack_in_the_frame_are_traversed_whole() {
     }
 }
 
+/// For each node of a tree, the boxes the packet's frustum may enter, and those each ray
+/// enters by its own slab test with its entry distances.
+struct FrustumAndRays<'a> {
+    nodes: &'a [BvhNode],
+    rays: &'a [Ray],
+    t_max: Real,
+}
+
+/// Per node: the frustum's bits and entry bounds, and each ray's bits and entries.
+type NodeTests = (u32, [Real; WIDTH], Vec<(u32, [Real; WIDTH])>);
+
+impl Kernel for FrustumAndRays<'_> {
+    type Output = Option<Vec<NodeTests>>;
+    fn run<I: Isa>(self) -> Self::Output {
+        let lanes = PacketLanes::<I>::new(self.rays).expect("rays that make a packet");
+        let mut tests = Vec::new();
+        for node in self.nodes {
+            let mut planes = [[R8::<I>::splat(0.0); 3]; 2];
+            for (side, planes) in planes.iter_mut().enumerate() {
+                for (axis, planes) in planes.iter_mut().enumerate() {
+                    *planes = node.planes::<I>(side, axis);
+                }
+            }
+            let (bound, may_enter) = lanes.may_enter(&planes, self.t_max * BOX_SLACK)?;
+            let mut bounds = [0.0; WIDTH];
+            bound.store(&mut bounds);
+            let mut rays = Vec::new();
+            for ray in self.rays {
+                let (t_enter, hits) = traverse::node_hits::<I>(node, &traverse::SlabLanes::new(ray), self.t_max);
+                let mut entries = [0.0; WIDTH];
+                t_enter.store(&mut entries);
+                rays.push((hits, entries));
+            }
+            tests.push((may_enter & node.used(), bounds, rays));
+        }
+        Some(tests)
+    }
+}
+
+#[test]
+fn a_packets_frustum_keeps_every_box_a_ray_enters_and_culls_others() {
+    let (_, bvh) = overlapping_boxes();
+    let tile = |origin: Vec3, aim: Vec3, step: Real| -> Vec<Ray> {
+        (0..PACKET)
+            .map(|k| {
+                let offset = Vec3::new((k % 4) as Real, (k / 4) as Real, 0.0) * step;
+                Ray::new(origin + offset * 0.1, (aim + offset - origin).normalize())
+            })
+            .collect()
+    };
+    let packets = [
+        tile(Vec3::new(50.0, 26.0, -60.0), Vec3::new(40.0, 20.0, 10.0), 0.7),
+        tile(Vec3::new(-30.0, -20.0, 80.0), Vec3::new(60.0, 30.0, 10.0), 2.5),
+        tile(Vec3::new(50.0, 26.0, 14.0), Vec3::new(90.0, 40.0, 20.0), 0.2),
+    ];
+    for path in crate::simd::available() {
+        for rays in &packets {
+            for t_max in [Real::INFINITY, 30.0] {
+                let tests = crate::simd::dispatch_on(path, FrustumAndRays { nodes: bvh.nodes(), rays, t_max })
+                    .unwrap()
+                    .expect("finite inverses make a frustum");
+                let (mut kept, mut entered) = (0, 0);
+                for (may_enter, bounds, rays) in &tests {
+                    let mut any_ray = 0;
+                    for (hits, entries) in rays {
+                        assert_eq!(hits & !may_enter, 0, "{path:?}: a ray enters a box the frustum culls");
+                        for slot in (0..WIDTH).filter(|&slot| hits >> slot & 1 != 0) {
+                            assert!(bounds[slot] <= entries[slot], "{path:?}: the frustum's entry is farther");
+                        }
+                        any_ray |= hits;
+                    }
+                    (kept, entered) = (kept + may_enter.count_ones(), entered + any_ray.count_ones());
+                }
+                let used: u32 = bvh.nodes().iter().map(|node| node.used().count_ones()).sum();
+                assert!(kept < used / 4, "{path:?}: kept {kept} of {used} boxes, {entered} entered");
+                assert!(entered > 0 || t_max < Real::INFINITY, "{path:?}: the rays enter no box");
+            }
+        }
+    }
+}

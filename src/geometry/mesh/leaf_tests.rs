@@ -157,4 +157,9 @@ impl<I: Isa> PacketVisitor<I> for NearestTriangles<'_, I> {
             }
         }
     }
+
+    #[inline(always)]
+    fn prefetch(&self, first: u32, count: u32) {
+        prefetch_packs::<I>(self.mesh, first, count);
+    }
 }

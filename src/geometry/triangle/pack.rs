@@ -5,6 +5,7 @@
 
 use super::super::real::{R4, R8, Real, Vec3, edge8, gamma, narrow4, wide4};
 use super::super::Ray;
+use super::super::lanes;
 use super::*;
 use crate::simd::{Isa, Lanes, MaskOps};
 
@@ -172,38 +173,46 @@ pub struct RayLanes<I: Isa> {
 }
 
 impl<I: Isa> RayLanes<I> {
-    /// `None` when the rays do not all turn the same axis into z (or there are more than
-    /// eight); lanes past the last ray repeat it.
+    /// `None` when the rays do not all turn the same axis into z (or there are none or more
+    /// than eight); lanes past the last ray repeat it.
     #[inline(always)]
     pub fn new(rays: &[Ray]) -> Option<Self> {
         if rays.is_empty() || rays.len() > 8 {
             return None;
         }
-        let first = TriangleRay::new(&rays[0]);
-        let mut lanes = [[0.0; 8]; 6];
-        for lane in 0..8 {
-            let ray = &rays[lane.min(rays.len() - 1)];
-            let triangle_ray = TriangleRay::new(ray);
-            if triangle_ray.axis_z != first.axis_z {
-                return None;
-            }
-            let origin = permute(ray.origin, first.axis_z);
-            let shear = triangle_ray.shear;
-            for (values, value) in lanes.iter_mut().zip([origin.x, origin.y, origin.z, shear.x, shear.y, shear.z]) {
-                values[lane] = value;
-            }
+        RayLanes::from_lanes(&lanes::RayLanes::gather(rays))
+    }
+
+    /// [`RayLanes::new`] of rays already side by side: [`TriangleRay::new`] lane by lane.
+    #[inline(always)]
+    pub fn from_lanes(rays: &lanes::RayLanes<I>) -> Option<Self> {
+        let d = rays.direction.abs();
+        // `TriangleRay::new`'s choice of the largest component, as masks: x where it beats y
+        // and z, y where it does not beat y and y beats z, z elsewhere.
+        let x_beats_y = d.x.gt(d.y);
+        let x_largest = x_beats_y.and(d.x.gt(d.z)).bits();
+        let y_largest = d.y.gt(d.z).and_not(x_beats_y).bits();
+        let axis_z = match (x_largest, y_largest) {
+            (0xff, _) => 0,
+            (_, 0xff) => 1,
+            (0, 0) => 2,
+            _ => return None,
+        };
+        // `permute`: the cyclic order that moves `axis_z` to z.
+        let axes = match axis_z {
+            0 => [1, 2, 0],
+            1 => [2, 0, 1],
+            _ => [0, 1, 2],
+        };
+        let (o, d) = ([rays.origin.x, rays.origin.y, rays.origin.z], [rays.direction.x, rays.direction.y, rays.direction.z]);
+        let (dx, dy, dz) = (d[axes[0]], d[axes[1]], d[axes[2]]);
+        let origin = [o[axes[0]], o[axes[1]], o[axes[2]]];
+        let shear = [-dx / dz, -dy / dz, R8::<I>::splat(1.0) / dz];
+        let mut values = [[0.0; 8]; 6];
+        for (values, lanes) in values.iter_mut().zip(origin.iter().chain(&shear)) {
+            lanes.store(values);
         }
-        let l = &lanes;
-        Some(RayLanes {
-            axes: match first.axis_z {
-                0 => [1, 2, 0],
-                1 => [2, 0, 1],
-                _ => [0, 1, 2],
-            },
-            origin: [R8::<I>::load(&l[0]), R8::<I>::load(&l[1]), R8::<I>::load(&l[2])],
-            shear: [R8::<I>::load(&l[3]), R8::<I>::load(&l[4]), R8::<I>::load(&l[5])],
-            values: lanes,
-        })
+        Some(RayLanes { axes, origin, shear, values })
     }
 
     /// Lane `lane`'s ray as [`PackRay::new`] makes it, for testing a pack's four triangles
