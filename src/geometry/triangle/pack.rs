@@ -275,10 +275,15 @@ fn finish_test<L: Lanes<Elem = Real>>(p: [[L; 3]; 3], e: [L; 3], shear_z: L, t_m
     let (z0, z1, z2) = (p0[2] * shear_z, p1[2] * shear_z, p2[2] * shear_z);
     let t_scaled = e0 * z0 + e1 * z1 + e2 * z2;
     let in_front = det.gt(zero).and(t_scaled.gt(zero)).or(det.lt(zero).and(t_scaled.lt(zero)));
+    // Most packs are missed by every lane, seen from the edges alone: the division and the
+    // error bound below are only needed for the others.
+    let inside = in_front.and_not(negative.and(positive));
+    if inside.bits() & live == 0 {
+        return LaneHits { lanes: 0, t: zero, edges: [e0, e1, e2], inv_det: zero };
+    }
     let inv_det = splat(1.0) / det;
     let t = t_scaled * inv_det;
-    // Most packs are missed by every lane; the error bound below is only needed for the others.
-    let candidates = in_front.and_not(negative.and(positive)).and(t.le(t_max));
+    let candidates = inside.and(t.le(t_max));
     if candidates.bits() & live == 0 {
         return LaneHits { lanes: 0, t, edges: [e0, e1, e2], inv_det };
     }
