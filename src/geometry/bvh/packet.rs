@@ -5,7 +5,7 @@ use super::super::lanes::RayLanes;
 use super::super::real::{R8, Real};
 use crate::simd::{Isa, Lanes, MaskOps};
 use super::*;
-use super::traverse::{StackSpace, sort_key};
+use super::traverse::{StackSpace, prefetch_node, sort_key};
 
 pub const PACKET: usize = 8;
 
@@ -186,7 +186,7 @@ pub fn traverse_packet<I: Isa>(
     let mut stack = space.stack(nodes);
     let mut current = PacketPending { t: 0.0, index: 0, count: 0, rays };
     // The farthest any ray may still reach, for the frustum's test; it changes only at leaves.
-    let mut reach = max_lane::<I>(R8::<I>::load(&t_limit[..]) * R8::<I>::splat(BOX_SLACK));
+    let mut reach = range::<I>(R8::<I>::load(&t_limit[..]) * R8::<I>::splat(BOX_SLACK))[1];
     loop {
         if current.count == 0 {
             let node = &nodes[current.index as usize];
@@ -234,7 +234,7 @@ pub fn traverse_packet<I: Isa>(
                         // Usually every ray that enters the box is one of the current rays, and
                         // the nearest entry is one select and a tree of minimums; else lane by
                         // lane.
-                        min_lane::<I>(R8::<I>::select(entered_lanes, t_enter, R8::<I>::splat(Real::INFINITY)))
+                        range::<I>(R8::<I>::select(entered_lanes, t_enter, R8::<I>::splat(Real::INFINITY)))[0]
                     } else {
                         let mut t = [0.0; PACKET];
                         t_enter.store(&mut t);
@@ -274,7 +274,7 @@ pub fn traverse_packet<I: Isa>(
             }
         } else {
             visitor.leaf(current.index, current.count, current.rays, t_limit);
-            reach = max_lane::<I>(R8::<I>::load(&t_limit[..]) * R8::<I>::splat(BOX_SLACK));
+            reach = range::<I>(R8::<I>::load(&t_limit[..]) * R8::<I>::splat(BOX_SLACK))[1];
         }
         loop {
             let Some(pending) = stack.pop() else { return };
@@ -294,10 +294,7 @@ pub fn traverse_packet<I: Isa>(
 #[inline(always)]
 fn fetch<I: Isa>(nodes: &[BvhNode], pending: &PacketPending, visitor: &impl PacketVisitor<I>) {
     if pending.count == 0 {
-        let waiting: *const BvhNode = &nodes[pending.index as usize];
-        for line in 0..size_of::<BvhNode>().div_ceil(64) {
-            I::prefetch(waiting.cast::<u8>().wrapping_add(64 * line));
-        }
+        prefetch_node::<I>(nodes, pending.index);
     } else {
         visitor.prefetch(pending.index, pending.count);
     }
@@ -313,24 +310,6 @@ fn range<I: Isa>(lanes: R8<I>) -> [Real; 2] {
         (low, high) = (low.min(value), high.max(value));
     }
     [low, high]
-}
-
-/// The largest lane (none being NaN), by a tree of maximums over the stored lanes.
-#[inline(always)]
-fn max_lane<I: Isa>(lanes: R8<I>) -> Real {
-    let mut t = [0.0; PACKET];
-    lanes.store(&mut t);
-    let pairs = [t[0].max(t[4]), t[1].max(t[5]), t[2].max(t[6]), t[3].max(t[7])];
-    pairs[0].max(pairs[2]).max(pairs[1].max(pairs[3]))
-}
-
-/// The smallest lane (none being NaN), by a tree of minimums over the stored lanes.
-#[inline(always)]
-fn min_lane<I: Isa>(lanes: R8<I>) -> Real {
-    let mut t = [0.0; PACKET];
-    lanes.store(&mut t);
-    let pairs = [t[0].min(t[4]), t[1].min(t[5]), t[2].min(t[6]), t[3].min(t[7])];
-    pairs[0].min(pairs[2]).min(pairs[1].min(pairs[3]))
 }
 
 /// The distance a [`sort_key`] was made from, to within its dropped low bits (rounded down, so

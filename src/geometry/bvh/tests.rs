@@ -298,20 +298,24 @@ impl Kernel for AloneAndPacket<'_> {
     }
 }
 
+/// A packet of rays through a tile of 4×2 points around `aim`, `step` apart, from `origin`
+/// moved by `spread` times each point's offset (0: camera rays from one point).
+fn tile(origin: Vec3, spread: Real, aim: Vec3, step: Real) -> Vec<Ray> {
+    (0..PACKET)
+        .map(|k| {
+            let offset = Vec3::new((k % 4) as Real, (k / 4) as Real, 0.0) * step;
+            Ray::new(origin + offset * spread, (aim + offset - origin).normalize())
+        })
+        .collect()
+}
+
 #[test]
 fn a_packet_reaches_every_leaf_its_rays_reach_alone() {
     let (points, bvh) = overlapping_boxes();
     // Tiles of camera rays from one point, among them one from exactly a box's corner and one
     // whose rays start inside the boxes; then rays from eight points and a tile with a direction
     // component of zero.
-    let tile = |origin: Vec3, aim: Vec3, step: Real| -> Vec<Ray> {
-        (0..PACKET)
-            .map(|k| {
-                let offset = Vec3::new((k % 4) as Real, (k / 4) as Real, 0.0) * step;
-                Ray::new(origin, (aim + offset - origin).normalize())
-            })
-            .collect()
-    };
+    let tile = |origin, aim, step| tile(origin, 0.0, aim, step);
     let mut packets = vec![
         tile(Vec3::new(50.0, 26.0, -60.0), Vec3::new(40.0, 20.0, 10.0), 0.7),
         tile(Vec3::new(-30.0, -20.0, 80.0), Vec3::new(60.0, 30.0, 10.0), 2.5),
@@ -464,14 +468,7 @@ impl Kernel for FrustumAndRays<'_> {
 #[test]
 fn a_packets_frustum_keeps_every_box_a_ray_enters_and_culls_others() {
     let (_, bvh) = overlapping_boxes();
-    let tile = |origin: Vec3, aim: Vec3, step: Real| -> Vec<Ray> {
-        (0..PACKET)
-            .map(|k| {
-                let offset = Vec3::new((k % 4) as Real, (k / 4) as Real, 0.0) * step;
-                Ray::new(origin + offset * 0.1, (aim + offset - origin).normalize())
-            })
-            .collect()
-    };
+    let tile = |origin, aim, step| tile(origin, 0.1, aim, step);
     let packets = [
         tile(Vec3::new(50.0, 26.0, -60.0), Vec3::new(40.0, 20.0, 10.0), 0.7),
         tile(Vec3::new(-30.0, -20.0, 80.0), Vec3::new(60.0, 30.0, 10.0), 2.5),

@@ -172,12 +172,18 @@ impl<'a, T: Copy> Stack<'a, T> {
 #[inline(always)]
 fn fetch<I: Isa>(nodes: &[BvhNode], pending: &Pending, visitor: &impl LeafVisitor<I>) {
     if pending.count == 0 {
-        let waiting: *const BvhNode = &nodes[pending.index as usize];
-        for line in 0..size_of::<BvhNode>().div_ceil(64) {
-            I::prefetch(waiting.cast::<u8>().wrapping_add(64 * line));
-        }
+        prefetch_node::<I>(nodes, pending.index);
     } else {
         visitor.prefetch(pending.index, pending.count);
+    }
+}
+
+/// Asks for the cache lines of node `index`.
+#[inline(always)]
+pub(super) fn prefetch_node<I: Isa>(nodes: &[BvhNode], index: u32) {
+    let node: *const BvhNode = &nodes[index as usize];
+    for line in 0..size_of::<BvhNode>().div_ceil(64) {
+        I::prefetch(node.cast::<u8>().wrapping_add(64 * line));
     }
 }
 
