@@ -9,7 +9,6 @@ use super::traverse::{StackSpace, prefetch_node, sort_key};
 
 pub const PACKET: usize = 8;
 
-
 /// The per-ray part of the slab test for a packet of up to eight rays, one per lane, which
 /// share the signs of their directions.
 pub struct PacketLanes<I: Isa> {
@@ -205,11 +204,15 @@ pub fn traverse_packet<I: Isa>(
             let mut used = node.used();
             // With a frustum, the boxes are ordered by its entry distances, each no farther
             // than the nearest ray's (the order only decides how soon a box is visited).
-            let mut frustum_entry = [Real::NAN; WIDTH];
-            if let Some((t_enter, may_enter)) = lanes.may_enter(&plane_lanes, reach) {
-                t_enter.store(&mut frustum_entry);
-                used &= may_enter;
-            }
+            let frustum_entry = match lanes.may_enter(&plane_lanes, reach) {
+                Some((t_enter, may_enter)) => {
+                    used &= may_enter;
+                    let mut entry = [0.0; WIDTH];
+                    t_enter.store(&mut entry);
+                    Some(entry)
+                }
+                None => None,
+            };
             while used != 0 {
                 let slot = used.trailing_zeros() as usize;
                 used &= used - 1;
@@ -228,12 +231,12 @@ pub fn traverse_packet<I: Isa>(
                 let any_ray = entered_lanes.bits();
                 let entered = any_ray & current.rays;
                 if entered != 0 {
-                    let nearest = if lanes.frustum.is_some() {
-                        frustum_entry[slot]
+                    let nearest = if let Some(entry) = &frustum_entry {
+                        entry[slot]
                     } else if entered == any_ray {
                         // Usually every ray that enters the box is one of the current rays, and
-                        // the nearest entry is one select and a tree of minimums; else lane by
-                        // lane.
+                        // the nearest entry is one select and the range of the lanes; else lane
+                        // by lane.
                         range::<I>(R8::<I>::select(entered_lanes, t_enter, R8::<I>::splat(Real::INFINITY)))[0]
                     } else {
                         let mut t = [0.0; PACKET];

@@ -315,18 +315,17 @@ fn a_packet_reaches_every_leaf_its_rays_reach_alone() {
     // Tiles of camera rays from one point, among them one from exactly a box's corner and one
     // whose rays start inside the boxes; then rays from eight points and a tile with a direction
     // component of zero.
-    let tile = |origin, aim, step| tile(origin, 0.0, aim, step);
     let mut packets = vec![
-        tile(Vec3::new(50.0, 26.0, -60.0), Vec3::new(40.0, 20.0, 10.0), 0.7),
-        tile(Vec3::new(-30.0, -20.0, 80.0), Vec3::new(60.0, 30.0, 10.0), 2.5),
-        tile(points[17], Vec3::new(0.0, 0.0, 0.0), 1.0),
-        tile(Vec3::new(50.0, 26.0, 14.0), Vec3::new(90.0, 40.0, 20.0), 0.2),
+        tile(Vec3::new(50.0, 26.0, -60.0), 0.0, Vec3::new(40.0, 20.0, 10.0), 0.7),
+        tile(Vec3::new(-30.0, -20.0, 80.0), 0.0, Vec3::new(60.0, 30.0, 10.0), 2.5),
+        tile(points[17], 0.0, Vec3::new(0.0, 0.0, 0.0), 1.0),
+        tile(Vec3::new(50.0, 26.0, 14.0), 0.0, Vec3::new(90.0, 40.0, 20.0), 0.2),
     ];
     let scattered: Vec<Ray> = (0..PACKET)
         .map(|k| Ray::new(Vec3::new(k as Real, -10.0, -10.0), Vec3::new(1.0, 0.6, 0.3).normalize()))
         .collect();
     packets.push(scattered);
-    packets.push(tile(Vec3::new(20.0, 20.0, -50.0), Vec3::new(20.0, 20.0, 10.0), 0.0));
+    packets.push(tile(Vec3::new(20.0, 20.0, -50.0), 0.0, Vec3::new(20.0, 20.0, 10.0), 0.0));
     let mut t_max = [Real::INFINITY; PACKET];
     t_max[3] = 40.0;
     for path in crate::simd::available() {
@@ -468,11 +467,10 @@ impl Kernel for FrustumAndRays<'_> {
 #[test]
 fn a_packets_frustum_keeps_every_box_a_ray_enters_and_culls_others() {
     let (_, bvh) = overlapping_boxes();
-    let tile = |origin, aim, step| tile(origin, 0.1, aim, step);
     let packets = [
-        tile(Vec3::new(50.0, 26.0, -60.0), Vec3::new(40.0, 20.0, 10.0), 0.7),
-        tile(Vec3::new(-30.0, -20.0, 80.0), Vec3::new(60.0, 30.0, 10.0), 2.5),
-        tile(Vec3::new(50.0, 26.0, 14.0), Vec3::new(90.0, 40.0, 20.0), 0.2),
+        tile(Vec3::new(50.0, 26.0, -60.0), 0.1, Vec3::new(40.0, 20.0, 10.0), 0.7),
+        tile(Vec3::new(-30.0, -20.0, 80.0), 0.1, Vec3::new(60.0, 30.0, 10.0), 2.5),
+        tile(Vec3::new(50.0, 26.0, 14.0), 0.1, Vec3::new(90.0, 40.0, 20.0), 0.2),
     ];
     for path in crate::simd::available() {
         for rays in &packets {

@@ -53,6 +53,16 @@ impl TrianglePack {
     }
 }
 
+/// The axes [`permute`] puts in x, y and z: the cyclic order that moves `axis_z` to z.
+#[inline(always)]
+fn permutation(axis_z: usize) -> [usize; 3] {
+    match axis_z {
+        0 => [1, 2, 0],
+        1 => [2, 0, 1],
+        _ => [0, 1, 2],
+    }
+}
+
 /// [`TriangleRay`] splatted across the lanes of a pack test.
 #[derive(Clone, Copy)]
 pub struct PackRay<I: Isa> {
@@ -67,11 +77,7 @@ impl<I: Isa> PackRay<I> {
     #[inline(always)]
     pub fn new(ray: &Ray) -> Self {
         let triangle_ray = TriangleRay::new(ray);
-        let axes = match triangle_ray.axis_z {
-            0 => [1, 2, 0],
-            1 => [2, 0, 1],
-            _ => [0, 1, 2],
-        };
+        let axes = permutation(triangle_ray.axis_z);
         let shear = triangle_ray.shear;
         PackRay {
             axes,
@@ -198,12 +204,7 @@ impl<I: Isa> RayLanes<I> {
             (0, 0) => 2,
             _ => return None,
         };
-        // `permute`: the cyclic order that moves `axis_z` to z.
-        let axes = match axis_z {
-            0 => [1, 2, 0],
-            1 => [2, 0, 1],
-            _ => [0, 1, 2],
-        };
+        let axes = permutation(axis_z);
         let (o, d) = ([rays.origin.x, rays.origin.y, rays.origin.z], [rays.direction.x, rays.direction.y, rays.direction.z]);
         let (dx, dy, dz) = (d[axes[0]], d[axes[1]], d[axes[2]]);
         let origin = [o[axes[0]], o[axes[1]], o[axes[2]]];
