@@ -64,7 +64,7 @@ impl Frustum {
     /// A bit per box (lane) that some ray of the packet may enter for a `t` up to `t_max`,
     /// a superset of the boxes the per-ray test finds entered by any ray whose limit is at
     /// most `t_max`, and per box a distance no farther than any ray's entry (non-negative,
-    /// never NaN). `planes[side][axis]` are the boxes' planes, as the per-ray test reads them,
+    /// never NaN). `planes` are the boxes' entry and exit planes ([`PacketLanes::entry_exit`]),
     /// and `negative` the packet's direction signs.
     #[inline(always)]
     fn may_enter<I: Isa>(&self, planes: &[[R8<I>; 3]; 2], negative: [bool; 3], t_max: Real) -> (R8<I>, u32) {
@@ -73,7 +73,7 @@ impl Frustum {
         let mut t_exit = splat(t_max);
         for axis in 0..3 {
             let negative = negative[axis] as usize;
-            let (near, far) = (planes[negative][axis], planes[1 - negative][axis]);
+            let (near, far) = (planes[0][axis], planes[1][axis]);
             let [origin_low, origin_high] = self.origin[axis];
             // The product of a positive inverse grows with the difference, of a negative one
             // shrinks: the nearest entry takes the smallest difference then, else the largest,
@@ -95,10 +95,23 @@ impl Frustum {
 }
 
 impl<I: Isa> PacketLanes<I> {
+    /// A node's planes as the packet's rays meet them: `[0][axis]` the planes every ray enters
+    /// its boxes by (the minimum corners' on an axis the rays go up, else the maximum ones'),
+    /// `[1][axis]` the planes they leave by. Ordered once per node, the per-ray test indexes
+    /// them by slot alone.
+    #[inline(always)]
+    pub(super) fn entry_exit(&self, node: &BvhNode) -> [[R8<I>; 3]; 2] {
+        let [x, y, z] = self.negative.map(usize::from);
+        [
+            [node.planes::<I>(x, 0), node.planes::<I>(y, 1), node.planes::<I>(z, 2)],
+            [node.planes::<I>(1 - x, 0), node.planes::<I>(1 - y, 1), node.planes::<I>(1 - z, 2)],
+        ]
+    }
+
     /// The packet's test of eight boxes at once ([`Frustum`]), when it has one: a bit per box
     /// that some ray may enter for a `t` up to `reach` (a superset of those the rays enter each
     /// by its own test) and per box a distance no farther than any ray's entry.
-    /// `planes[side][axis]` are the boxes' planes, as the per-ray test reads them.
+    /// `planes` are the boxes' entry and exit planes ([`PacketLanes::entry_exit`]).
     #[inline(always)]
     pub(super) fn may_enter(&self, planes: &[[R8<I>; 3]; 2], reach: Real) -> Option<(R8<I>, u32)> {
         match &self.frustum {
@@ -186,18 +199,20 @@ pub fn traverse_packet<I: Isa>(
     let mut current = PacketPending { t: 0.0, index: 0, count: 0, rays };
     // The farthest any ray may still reach, for the frustum's test; it changes only at leaves.
     let mut reach = range::<I>(R8::<I>::load(&t_limit[..]) * R8::<I>::splat(BOX_SLACK))[1];
+    // A node's entered children, nearest first; only the first `hit` are meaningful, so the
+    // array is filled once, not for every node.
+    let mut children = [(0u64, 0u32); WIDTH];
     loop {
         if current.count == 0 {
             let node = &nodes[current.index as usize];
             let limit = R8::<I>::load(&t_limit[..]) * R8::<I>::splat(BOX_SLACK);
-            let mut children = [(0u64, 0u32); WIDTH];
             let mut hit = 0;
-            // The node's planes, as one ray's traversal computes them, then lane by lane.
-            let mut plane_lanes = [[R8::<I>::splat(0.0); 3]; 2];
+            // The node's entry and exit planes, as one ray's traversal computes them, then
+            // lane by lane.
+            let plane_lanes = lanes.entry_exit(node);
             let mut planes = [[[0.0; WIDTH]; 3]; 2];
             for side in 0..2 {
                 for axis in 0..3 {
-                    plane_lanes[side][axis] = node.planes::<I>(side, axis);
                     plane_lanes[side][axis].store(&mut planes[side][axis]);
                 }
             }
@@ -219,9 +234,8 @@ pub fn traverse_packet<I: Isa>(
                 let mut t_enter = R8::<I>::splat(0.0);
                 let mut t_exit = limit;
                 for axis in 0..3 {
-                    let negative = lanes.negative[axis] as usize;
-                    let near = R8::<I>::splat(planes[negative][axis][slot]);
-                    let far = R8::<I>::splat(planes[1 - negative][axis][slot]);
+                    let near = R8::<I>::splat(planes[0][axis][slot]);
+                    let far = R8::<I>::splat(planes[1][axis][slot]);
                     let t_near = (near - lanes.origin[axis]) * lanes.inverse[axis];
                     let t_far = (far - lanes.origin[axis]) * lanes.far_inverse[axis];
                     t_enter = t_near.max(t_enter);
@@ -308,11 +322,18 @@ fn fetch<I: Isa>(nodes: &[BvhNode], pending: &PacketPending, visitor: &impl Pack
 fn range<I: Isa>(lanes: R8<I>) -> [Real; 2] {
     let mut values = [0.0; PACKET];
     lanes.store(&mut values);
-    let (mut low, mut high) = (values[0], values[0]);
-    for &value in &values[1..] {
-        (low, high) = (low.min(value), high.max(value));
-    }
+    // As trees of comparisons: a comparison and a select are one instruction each, where
+    // `Real::min` and `Real::max` take several to handle NaNs, and there are none here.
+    let low = reduce_pairwise(&values, |a, b| if b < a { b } else { a });
+    let high = reduce_pairwise(&values, |a, b| if b > a { b } else { a });
     [low, high]
+}
+
+/// The eight values folded as a balanced tree, so the three levels' picks are independent.
+#[inline(always)]
+fn reduce_pairwise(values: &[Real; PACKET], pick: impl Fn(Real, Real) -> Real) -> Real {
+    let pair = |i: usize| pick(values[i], values[i + 1]);
+    pick(pick(pair(0), pair(2)), pick(pair(4), pair(6)))
 }
 
 /// The distance a [`sort_key`] was made from, to within its dropped low bits (rounded down, so

@@ -1,5 +1,5 @@
 use super::*;
-use super::super::real::{R8, Vec3};
+use super::super::real::Vec3;
 use crate::simd::Lanes;
 
 fn point_boxes(points: &[Vec3]) -> Vec<Aabb> {
@@ -442,13 +442,7 @@ impl Kernel for FrustumAndRays<'_> {
         let lanes = PacketLanes::<I>::new(self.rays).expect("rays that make a packet");
         let mut tests = Vec::new();
         for node in self.nodes {
-            let mut planes = [[R8::<I>::splat(0.0); 3]; 2];
-            for (side, planes) in planes.iter_mut().enumerate() {
-                for (axis, planes) in planes.iter_mut().enumerate() {
-                    *planes = node.planes::<I>(side, axis);
-                }
-            }
-            let (bound, may_enter) = lanes.may_enter(&planes, self.t_max * BOX_SLACK)?;
+            let (bound, may_enter) = lanes.may_enter(&lanes.entry_exit(node), self.t_max * BOX_SLACK)?;
             let mut bounds = [0.0; WIDTH];
             bound.store(&mut bounds);
             let mut rays = Vec::new();
