@@ -111,32 +111,43 @@ pub(super) const LOCAL_HEIGHT: usize = 12;
 /// entries waiting, plus the one being pushed.
 const LOCAL_ENTRIES: usize = (WIDTH - 1) * LOCAL_HEIGHT + 1;
 
-/// Room for a traversal stack's entries: in the frame for trees of up to [`LOCAL_HEIGHT`]
-/// levels, else on the heap, sized by the tree's height. Not initialised (zeroing the entries
-/// for every ray would cost more than most rays push).
-pub(super) struct StackSpace<T> {
-    local: [MaybeUninit<T>; LOCAL_ENTRIES],
+/// Room for `STACKS` traversal stacks' entries: in the frame for trees of up to
+/// [`LOCAL_HEIGHT`] levels, else on the heap, sized by the tree's height. Not initialised
+/// (zeroing the entries for every ray would cost more than most rays push), and one value
+/// rather than an array of them: an array repeated from a value that is partly initialised is
+/// copied in full, uninitialised bytes too (a kilobyte per stack).
+pub(super) struct StackSpace<T, const STACKS: usize = 1> {
+    local: [[MaybeUninit<T>; LOCAL_ENTRIES]; STACKS],
     heap: Vec<MaybeUninit<T>>,
 }
 
-impl<T> StackSpace<T> {
+impl<T, const STACKS: usize> StackSpace<T, STACKS> {
     #[inline(always)]
     pub(super) const fn new() -> Self {
         // SAFETY: an array of `MaybeUninit` needs no initialisation.
         StackSpace { local: unsafe { MaybeUninit::uninit().assume_init() }, heap: Vec::new() }
     }
 
+    /// `STACKS` empty stacks, each with room for any traversal of the tree `nodes` (root first).
+    #[inline(always)]
+    pub(super) fn stacks(&mut self, nodes: &[BvhNode]) -> [Stack<'_, T>; STACKS] {
+        let height = nodes.first().map_or(0, |root| root.height as usize);
+        if height <= LOCAL_HEIGHT {
+            return self.local.each_mut().map(|entries| Stack { entries, len: 0 });
+        }
+        let room = (WIDTH - 1) * height + 1;
+        self.heap.resize_with(room * STACKS, MaybeUninit::uninit);
+        let mut rooms = self.heap.chunks_exact_mut(room);
+        std::array::from_fn(|_| Stack { entries: rooms.next().expect("a room per stack"), len: 0 })
+    }
+}
+
+impl<T> StackSpace<T> {
     /// An empty stack with room for any traversal of the tree `nodes` (root first).
     #[inline(always)]
     pub(super) fn stack(&mut self, nodes: &[BvhNode]) -> Stack<'_, T> {
-        let height = nodes.first().map_or(0, |root| root.height as usize);
-        let entries = if height <= LOCAL_HEIGHT {
-            &mut self.local[..]
-        } else {
-            self.heap.resize_with((WIDTH - 1) * height + 1, MaybeUninit::uninit);
-            &mut self.heap[..]
-        };
-        Stack { entries, len: 0 }
+        let [stack] = self.stacks(nodes);
+        stack
     }
 }
 
@@ -197,7 +208,7 @@ pub(super) fn prefetch_node<I: Isa>(nodes: &[BvhNode], index: u32) {
 #[inline(always)]
 pub fn traverse<I: Isa>(nodes: &[BvhNode], ray: &Ray, t_max: Real, visitor: &mut impl LeafVisitor<I>) {
     let mut space = StackSpace::new();
-    let Some(mut walk) = Walk::<I>::new(nodes, ray, t_max, &mut space) else { return };
+    let Some(mut walk) = Walk::<I>::new(nodes, ray, t_max, space.stack(nodes)) else { return };
     while walk.step::<false>(nodes, visitor) {}
 }
 
@@ -221,21 +232,27 @@ pub fn traverse_interleaved<I: Isa, V: LeafVisitor<I>>(
     visitors: &mut [V],
 ) {
     assert!(rays.len() <= PACKET && visitors.len() >= rays.len(), "up to {PACKET} rays, a visitor each");
-    let mut spaces = [const { StackSpace::<Pending>::new() }; PACKET];
-    let mut walks = [const { None }; PACKET];
+    let mut space = StackSpace::<Pending, PACKET>::new();
+    // Uninitialised until a ray's walk starts, its bit then set in `active`: an array of
+    // `None`s would be written in full (three kilobytes) for every call.
+    let mut walks = [const { MaybeUninit::<Walk<'_, I>>::uninit() }; PACKET];
     let mut active = 0u32;
     // Loops rather than `array::from_fn`: a closure may be compiled outside the kernel,
     // without its instructions.
-    for (k, (space, ray)) in spaces.iter_mut().zip(rays).enumerate() {
-        walks[k] = Walk::<I>::new(nodes, ray, t_max[k], space);
-        active |= (walks[k].is_some() as u32) << k;
+    for (k, (stack, ray)) in space.stacks(nodes).into_iter().zip(rays).enumerate() {
+        if let Some(walk) = Walk::<I>::new(nodes, ray, t_max[k], stack) {
+            walks[k].write(walk);
+            active |= 1 << k;
+        }
     }
     while active != 0 {
         let mut turn = active;
         while turn != 0 {
             let k = turn.trailing_zeros() as usize;
             turn &= turn - 1;
-            let Some(walk) = walks[k].as_mut() else { continue };
+            // SAFETY: bit `k` of `active` (and so of `turn`) is set only once `walks[k]` is
+            // written. A walk owns nothing to drop, so leaving them uninitialised leaks nothing.
+            let walk = unsafe { walks[k].assume_init_mut() };
             if !walk.step::<true>(nodes, &mut visitors[k]) {
                 active &= !(1 << k);
             }
@@ -255,7 +272,7 @@ struct Walk<'a, I: Isa> {
 impl<'a, I: Isa> Walk<'a, I> {
     /// `None` when there is nothing to traverse or the ray is not finite.
     #[inline(always)]
-    fn new(nodes: &[BvhNode], ray: &Ray, t_max: Real, space: &'a mut StackSpace<Pending>) -> Option<Self> {
+    fn new(nodes: &[BvhNode], ray: &Ray, t_max: Real, stack: Stack<'a, Pending>) -> Option<Self> {
         if nodes.is_empty() || !(ray.origin.is_finite() && ray.direction.is_finite()) {
             return None;
         }
@@ -263,7 +280,7 @@ impl<'a, I: Isa> Walk<'a, I> {
             slab: SlabLanes::<I>::new(ray),
             t_limit: t_max,
             current: Pending { t: 0.0, index: 0, count: 0 },
-            stack: space.stack(nodes),
+            stack,
         })
     }
 
