@@ -232,6 +232,13 @@ pub trait Lanes:
     fn max(self, other: Self) -> Self;
     /// `self < other ? self : other` per lane (x86's `min`): a NaN in either gives `other`.
     fn min(self, other: Self) -> Self;
+    /// The lanes folded with [`Lanes::min`] as a halving tree: lane `i` against lane
+    /// `i + N/2`, the results' `i` against `i + N/4`, and so on. With the operands' order fixed
+    /// the result is the same lane on every path, NaN or not; a few shuffles on x86 where a
+    /// scalar fold takes a comparison and a select per lane.
+    fn min_lane(self) -> Self::Elem;
+    /// [`Lanes::min_lane`] with [`Lanes::max`].
+    fn max_lane(self) -> Self::Elem;
     fn lt(self, other: Self) -> Self::Mask;
     fn le(self, other: Self) -> Self::Mask;
     fn gt(self, other: Self) -> Self::Mask;
@@ -321,6 +328,69 @@ mod tests {
             ];
             for result in results.into_iter().flatten() {
                 assert_eq!(format!("{result:?}"), format!("{portable:?}"));
+            }
+        }
+    }
+
+    /// Lanes of eight values, shifted through every rotation of a set with NaNs, signed zeros
+    /// and infinities in it, folded by each lane type.
+    struct Folds;
+
+    impl Kernel for Folds {
+        type Output = Vec<u64>;
+        #[inline(always)]
+        fn run<I: Isa>(self) -> Vec<u64> {
+            let values = [
+                3.0,
+                -0.0,
+                f32::NAN,
+                0.0,
+                -7.5,
+                f32::INFINITY,
+                2.0,
+                f32::NEG_INFINITY,
+                1.0,
+                -0.0,
+                5.0,
+            ];
+            let mut folds = Vec::new();
+            for start in 0..values.len() {
+                let lanes: Vec<f32> = (0..8).map(|k| values[(start + k) % values.len()]).collect();
+                let wide: Vec<f64> = lanes.iter().map(|&v| v as f64).collect();
+                let (x8, x4) = (I::F32x8::load(&lanes), I::F32x4::load(&lanes));
+                let (d8, d4) = (I::F64x8::load(&wide), I::F64x4::load(&wide));
+                for f in [x8.min_lane(), x8.max_lane(), x4.min_lane(), x4.max_lane()] {
+                    folds.push(f.to_bits() as u64);
+                }
+                for d in [d8.min_lane(), d8.max_lane(), d4.min_lane(), d4.max_lane()] {
+                    folds.push(d.to_bits());
+                }
+            }
+            folds
+        }
+    }
+
+    #[test]
+    fn lanes_fold_to_the_same_bits_on_every_path() {
+        let portable = Folds.run::<Portable>();
+        // Lanes 3.0, −0.0, NaN, 0.0, −7.5, ∞, 2.0, −∞: the NaN lane meets 2.0 first and gives
+        // it, so the smallest lane is −∞ and the largest ∞.
+        assert_eq!(f32::from_bits(portable[0] as u32), f32::NEG_INFINITY);
+        assert_eq!(f32::from_bits(portable[1] as u32), f32::INFINITY);
+        // Of 3.0, −0.0, NaN, 0.0: 3.0 against the NaN gives the NaN, −0.0 against 0.0 the second
+        // operand, and the NaN against 0.0 gives 0.0, as the smallest lane and the largest.
+        assert_eq!(portable[2], 0.0f32.to_bits() as u64);
+        assert_eq!(portable[3], 0.0f32.to_bits() as u64);
+        #[cfg(target_arch = "x86_64")]
+        {
+            // SAFETY: each trampoline runs only where the processor supports it.
+            let results = [
+                x86::has_avx2().then(|| unsafe { x86::run_avx2(Folds) }),
+                #[cfg(feature = "avx512")]
+                x86::has_avx512().then(|| unsafe { x86::run_avx512(Folds) }),
+            ];
+            for result in results.into_iter().flatten() {
+                assert_eq!(result, portable);
             }
         }
     }

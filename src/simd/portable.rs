@@ -102,6 +102,20 @@ macro_rules! array_lanes {
                 Array([$(f(a[$lane])),*])
             }
 
+            /// The lanes folded with `f` as [`Lanes::min_lane`]'s halving tree.
+            #[inline(always)]
+            fn fold(self, f: impl Fn($t, $t) -> $t) -> $t {
+                let mut lanes = self.0;
+                let mut half = $n / 2;
+                while half > 0 {
+                    for lane in 0..half {
+                        lanes[lane] = f(lanes[lane], lanes[lane + half]);
+                    }
+                    half /= 2;
+                }
+                lanes[0]
+            }
+
             #[inline(always)]
             fn compare(self, other: Self, f: impl Fn($t, $t) -> bool) -> Bits {
                 let (a, b) = (self.0, other.0);
@@ -182,6 +196,14 @@ macro_rules! array_lanes {
             #[inline(always)]
             fn min(self, other: Self) -> Self {
                 self.zip(other, |a, b| if a < b { a } else { b })
+            }
+            #[inline(always)]
+            fn min_lane(self) -> $t {
+                self.fold(|a, b| if a < b { a } else { b })
+            }
+            #[inline(always)]
+            fn max_lane(self) -> $t {
+                self.fold(|a, b| if a > b { a } else { b })
             }
             #[inline(always)]
             fn lt(self, other: Self) -> Bits {

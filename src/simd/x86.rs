@@ -125,6 +125,33 @@ isa!(Avx2);
 #[cfg(feature = "avx512")]
 isa!(Avx512);
 
+/// Four `f32` lanes folded as [`Lanes::min_lane`]'s halving tree with `packed` and `scalar`
+/// (both `min` or both `max`): lanes 0 and 1 against 2 and 3, then lane 0 against lane 1.
+#[inline(always)]
+unsafe fn fold4_ps(
+    v: __m128,
+    packed: unsafe fn(__m128, __m128) -> __m128,
+    scalar: unsafe fn(__m128, __m128) -> __m128,
+) -> f32 {
+    unsafe {
+        let halves = packed(v, _mm_movehl_ps(v, v));
+        _mm_cvtss_f32(scalar(halves, _mm_movehdup_ps(halves)))
+    }
+}
+
+/// Four `f64` lanes folded as [`fold4_ps`] folds four `f32`.
+#[inline(always)]
+unsafe fn fold4_pd(
+    v: __m256d,
+    packed: unsafe fn(__m128d, __m128d) -> __m128d,
+    scalar: unsafe fn(__m128d, __m128d) -> __m128d,
+) -> f64 {
+    unsafe {
+        let halves = packed(_mm256_castpd256_pd128(v), _mm256_extractf128_pd::<1>(v));
+        _mm_cvtsd_f64(scalar(halves, _mm_unpackhi_pd(halves, halves)))
+    }
+}
+
 /// Defines a lane type over one register: its arithmetic, and its mask (a register of the same
 /// type whose lanes are all ones or all zeros).
 macro_rules! register_lanes {
@@ -135,7 +162,8 @@ macro_rules! register_lanes {
         max: $max:ident, min: $min:ident, and: $and:ident, or: $or:ident, andnot: $andnot:ident,
         xor: $xor:ident, blend: $blend:ident, movemask: $movemask:ident,
         cmp: |$a:ident, $b:ident, $pred:ident| $cmp:expr,
-        bits: $to_bits:ident, from_bits: $from_bits:ident, int_add: $int_add:ident, int_sub: $int_sub:ident
+        bits: $to_bits:ident, from_bits: $from_bits:ident, int_add: $int_add:ident, int_sub: $int_sub:ident,
+        min_lane: |$min_v:ident| $min_lane:expr, max_lane: |$max_v:ident| $max_lane:expr
     ) => {
         #[derive(Clone, Copy, Debug)]
         pub struct $name($reg);
@@ -246,6 +274,16 @@ macro_rules! register_lanes {
                 $name(unsafe { $min(self.0, other.0) })
             }
             #[inline(always)]
+            fn min_lane(self) -> $elem {
+                let $min_v = self.0;
+                unsafe { $min_lane }
+            }
+            #[inline(always)]
+            fn max_lane(self) -> $elem {
+                let $max_v = self.0;
+                unsafe { $max_lane }
+            }
+            #[inline(always)]
             fn lt(self, other: Self) -> $mask {
                 self.compare::<_CMP_LT_OQ>(other)
             }
@@ -288,7 +326,8 @@ register_lanes!(
     max: _mm_max_ps, min: _mm_min_ps, and: _mm_and_ps, or: _mm_or_ps, andnot: _mm_andnot_ps,
     xor: _mm_xor_ps, blend: _mm_blendv_ps, movemask: _mm_movemask_ps,
     cmp: |a, b, P| _mm_cmp_ps::<P>(a, b),
-    bits: _mm_castps_si128, from_bits: _mm_castsi128_ps, int_add: _mm_add_epi32, int_sub: _mm_sub_epi32
+    bits: _mm_castps_si128, from_bits: _mm_castsi128_ps, int_add: _mm_add_epi32, int_sub: _mm_sub_epi32,
+    min_lane: |v| fold4_ps(v, _mm_min_ps, _mm_min_ss), max_lane: |v| fold4_ps(v, _mm_max_ps, _mm_max_ss)
 );
 
 register_lanes!(
@@ -298,7 +337,9 @@ register_lanes!(
     max: _mm256_max_ps, min: _mm256_min_ps, and: _mm256_and_ps, or: _mm256_or_ps, andnot: _mm256_andnot_ps,
     xor: _mm256_xor_ps, blend: _mm256_blendv_ps, movemask: _mm256_movemask_ps,
     cmp: |a, b, P| _mm256_cmp_ps::<P>(a, b),
-    bits: _mm256_castps_si256, from_bits: _mm256_castsi256_ps, int_add: _mm256_add_epi32, int_sub: _mm256_sub_epi32
+    bits: _mm256_castps_si256, from_bits: _mm256_castsi256_ps, int_add: _mm256_add_epi32, int_sub: _mm256_sub_epi32,
+    min_lane: |v| fold4_ps(_mm_min_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps::<1>(v)), _mm_min_ps, _mm_min_ss),
+    max_lane: |v| fold4_ps(_mm_max_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps::<1>(v)), _mm_max_ps, _mm_max_ss)
 );
 
 register_lanes!(
@@ -308,7 +349,8 @@ register_lanes!(
     max: _mm256_max_pd, min: _mm256_min_pd, and: _mm256_and_pd, or: _mm256_or_pd, andnot: _mm256_andnot_pd,
     xor: _mm256_xor_pd, blend: _mm256_blendv_pd, movemask: _mm256_movemask_pd,
     cmp: |a, b, P| _mm256_cmp_pd::<P>(a, b),
-    bits: _mm256_castpd_si256, from_bits: _mm256_castsi256_pd, int_add: _mm256_add_epi64, int_sub: _mm256_sub_epi64
+    bits: _mm256_castpd_si256, from_bits: _mm256_castsi256_pd, int_add: _mm256_add_epi64, int_sub: _mm256_sub_epi64,
+    min_lane: |v| fold4_pd(v, _mm_min_pd, _mm_min_sd), max_lane: |v| fold4_pd(v, _mm_max_pd, _mm_max_sd)
 );
 
 /// Eight `f64` lanes as two halves of four.
@@ -395,6 +437,14 @@ impl Lanes for F64x8 {
     #[inline(always)]
     fn min(self, other: Self) -> Self {
         F64x8([self.0[0].min(other.0[0]), self.0[1].min(other.0[1])])
+    }
+    #[inline(always)]
+    fn min_lane(self) -> f64 {
+        self.0[0].min(self.0[1]).min_lane()
+    }
+    #[inline(always)]
+    fn max_lane(self) -> f64 {
+        self.0[0].max(self.0[1]).max_lane()
     }
     #[inline(always)]
     fn lt(self, other: Self) -> M64x8 {

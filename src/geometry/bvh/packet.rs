@@ -198,7 +198,7 @@ pub fn traverse_packet<I: Isa>(
     let mut stack = space.stack(nodes);
     let mut current = PacketPending { t: 0.0, index: 0, count: 0, rays };
     // The farthest any ray may still reach, for the frustum's test; it changes only at leaves.
-    let mut reach = range::<I>(R8::<I>::load(&t_limit[..]) * R8::<I>::splat(BOX_SLACK))[1];
+    let mut reach = (R8::<I>::load(&t_limit[..]) * R8::<I>::splat(BOX_SLACK)).max_lane();
     // A node's entered children, nearest first; only the first `hit` are meaningful, so the
     // array is filled once, not for every node.
     let mut children = [(0u64, 0u32); WIDTH];
@@ -251,7 +251,7 @@ pub fn traverse_packet<I: Isa>(
                         // Usually every ray that enters the box is one of the current rays, and
                         // the nearest entry is one select and the range of the lanes; else lane
                         // by lane.
-                        range::<I>(R8::<I>::select(entered_lanes, t_enter, R8::<I>::splat(Real::INFINITY)))[0]
+                        R8::<I>::select(entered_lanes, t_enter, R8::<I>::splat(Real::INFINITY)).min_lane()
                     } else {
                         let mut t = [0.0; PACKET];
                         t_enter.store(&mut t);
@@ -291,7 +291,7 @@ pub fn traverse_packet<I: Isa>(
             }
         } else {
             visitor.leaf(current.index, current.count, current.rays, t_limit);
-            reach = range::<I>(R8::<I>::load(&t_limit[..]) * R8::<I>::splat(BOX_SLACK))[1];
+            reach = (R8::<I>::load(&t_limit[..]) * R8::<I>::splat(BOX_SLACK)).max_lane();
         }
         loop {
             let Some(pending) = stack.pop() else { return };
@@ -320,20 +320,7 @@ fn fetch<I: Isa>(nodes: &[BvhNode], pending: &PacketPending, visitor: &impl Pack
 /// The smallest and largest lane (none being NaN).
 #[inline(always)]
 fn range<I: Isa>(lanes: R8<I>) -> [Real; 2] {
-    let mut values = [0.0; PACKET];
-    lanes.store(&mut values);
-    // As trees of comparisons: a comparison and a select are one instruction each, where
-    // `Real::min` and `Real::max` take several to handle NaNs, and there are none here.
-    let low = reduce_pairwise(&values, |a, b| if b < a { b } else { a });
-    let high = reduce_pairwise(&values, |a, b| if b > a { b } else { a });
-    [low, high]
-}
-
-/// The eight values folded as a balanced tree, so the three levels' picks are independent.
-#[inline(always)]
-fn reduce_pairwise(values: &[Real; PACKET], pick: impl Fn(Real, Real) -> Real) -> Real {
-    let pair = |i: usize| pick(values[i], values[i + 1]);
-    pick(pick(pair(0), pair(2)), pick(pair(4), pair(6)))
+    [lanes.min_lane(), lanes.max_lane()]
 }
 
 /// The distance a [`sort_key`] was made from, to within its dropped low bits (rounded down, so
