@@ -14,7 +14,7 @@ use super::triangle::{
     PackRay, RayLanes, TriangleHit, TrianglePack, face_normal, normalize,
     triangle_surface,
 };
-use super::{Ray, SurfaceHit};
+use super::{Ray, SurfaceHit, lanes};
 use super::real::{Real, Vec3};
 pub use crate::build_error::MeshError;
 use flat::FlatLeaves;
@@ -181,7 +181,17 @@ impl Mesh {
     /// If there are more than [`PACKET`] rays.
     #[inline(always)]
     pub fn closest_packet<I: Isa>(&self, rays: &[Ray], t_max: &[Real; PACKET]) -> [Option<MeshHit>; PACKET] {
-        let (Some(slab), Some(triangle_rays)) = (PacketLanes::<I>::new(rays), RayLanes::<I>::new(rays)) else {
+        assert!(rays.len() <= PACKET, "a packet holds at most {PACKET} rays");
+        if rays.is_empty() {
+            return [None; PACKET];
+        }
+        // Gathered once for both set-ups, and the triangles' set-up made only for rays that
+        // make a packet: random rays fail the first and go their own ways.
+        let gathered = lanes::RayLanes::<I>::gather(rays);
+        let Some(slab) = PacketLanes::<I>::from_lanes(&gathered) else {
+            return self.closest_interleaved::<I>(rays, t_max);
+        };
+        let Some(triangle_rays) = RayLanes::<I>::from_lanes(&gathered) else {
             return self.closest_interleaved::<I>(rays, t_max);
         };
         let mut nearest = NearestTriangles { mesh: self, rays: triangle_rays, closest: [None; PACKET] };
