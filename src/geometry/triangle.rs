@@ -14,7 +14,10 @@ use super::real::{Real, Vec3, gamma};
 
 mod pack;
 
-pub use pack::{LaneHits, PackHits, PackRay, RayHits, RayLanes, TrianglePack, intersect_pack, intersect_triangle_rays, lane_hit};
+pub use pack::{
+    LaneHits, PackHits, PackRay, RayHits, RayLanes, TrianglePack, intersect_pack, intersect_pack_pair,
+    intersect_triangle_rays, lane_hit,
+};
 
 /// The per-ray part of the test: which axis becomes z, and the shear that makes the ray
 /// direction (0, 0, 1). Computing it once per ray saves that work for every triangle tested.

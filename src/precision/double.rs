@@ -16,6 +16,12 @@ pub fn narrow4<I: crate::simd::Isa>(x: I::F64x4) -> R4<I> {
     x
 }
 
+/// Four lanes and four more as eight.
+#[inline(always)]
+pub fn join4<I: crate::simd::Isa>(low: R4<I>, high: R4<I>) -> R8<I> {
+    I::join_f64(low, high)
+}
+
 /// The triangle test's edge function `a.x·b.y − a.y·b.x` on eight lanes (already `f64`).
 #[inline(always)]
 pub fn edge8<I: crate::simd::Isa>(ax: R8<I>, ay: R8<I>, bx: R8<I>, by: R8<I>) -> R8<I> {

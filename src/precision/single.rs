@@ -17,6 +17,12 @@ pub fn narrow4<I: crate::simd::Isa>(x: I::F64x4) -> R4<I> {
     I::narrow(x)
 }
 
+/// Four lanes and four more as eight.
+#[inline(always)]
+pub fn join4<I: crate::simd::Isa>(low: R4<I>, high: R4<I>) -> R8<I> {
+    I::join(low, high)
+}
+
 /// The triangle test's edge function `a.x·b.y − a.y·b.x` on eight lanes, in `f64` (exact
 /// products) rounded back, as `geometry::triangle` computes it lane by lane.
 #[inline(always)]

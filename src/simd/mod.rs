@@ -204,6 +204,8 @@ pub trait Isa: Copy + 'static {
     fn split(x: Self::F32x8) -> (Self::F32x4, Self::F32x4);
     /// The inverse of [`Isa::split`].
     fn join(low: Self::F32x4, high: Self::F32x4) -> Self::F32x8;
+    /// [`Isa::join`] of `f64` lanes.
+    fn join_f64(low: Self::F64x4, high: Self::F64x4) -> Self::F64x8;
     /// Asks for the cache line holding `address` to be loaded, without waiting for it (a hint
     /// that changes no result; nothing on the portable path).
     fn prefetch<T>(address: *const T);

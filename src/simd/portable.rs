@@ -39,6 +39,12 @@ impl Isa for Portable {
     }
 
     #[inline(always)]
+    fn join_f64(low: Array<f64, 4>, high: Array<f64, 4>) -> Array<f64, 8> {
+        let ([a, b, c, d], [e, f, g, h]) = (low.0, high.0);
+        Array([a, b, c, d, e, f, g, h])
+    }
+
+    #[inline(always)]
     fn prefetch<T>(_: *const T) {}
 
     #[inline(always)]

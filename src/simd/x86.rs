@@ -88,6 +88,11 @@ macro_rules! isa {
             }
 
             #[inline(always)]
+            fn join_f64(low: F64x4, high: F64x4) -> F64x8 {
+                F64x8([low, high])
+            }
+
+            #[inline(always)]
             fn prefetch<T>(address: *const T) {
                 // SAFETY: a prefetch never faults, whatever the address.
                 unsafe { _mm_prefetch::<_MM_HINT_T0>(address.cast()) }

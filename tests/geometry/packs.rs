@@ -5,8 +5,11 @@
 use goldray::geometry::Ray;
 use goldray::geometry::bvh::PACKET;
 use goldray::geometry::mesh::{Mesh, MeshHit, VertexNormals};
-use goldray::geometry::triangle::{TriangleRay, intersect_triangle};
+use goldray::geometry::triangle::{
+    RayLanes, TrianglePack, TriangleRay, intersect_pack, intersect_pack_pair, intersect_triangle,
+};
 use goldray::real::{Real, Vec3};
+use goldray::simd::{Isa, Kernel};
 use proptest::prelude::*;
 
 use super::{Rng, ray_through};
@@ -119,4 +122,98 @@ fn of_coinciding_triangles_the_smaller_index_wins() {
         assert_eq!(hit.triangle, 0);
         assert_eq!(from_packet, Some(hit));
     }
+}
+
+/// Per pack and pair of rays: the lanes each ray hits alone and in the pair, and the bits of
+/// the hit lanes' values (`t`, edges, inverse determinant) alone and in the pair.
+type PairRecord = ((u32, u32), (u32, u32), Vec<u64>, Vec<u64>);
+
+struct PairsAndSingles<'a> {
+    packs: &'a [TrianglePack],
+    rays: &'a [Ray],
+    t_max: &'a [Real; PACKET],
+}
+
+impl Kernel for PairsAndSingles<'_> {
+    type Output = Vec<PairRecord>;
+    fn run<I: Isa>(self) -> Vec<PairRecord> {
+        let lanes = RayLanes::<I>::new(self.rays).expect("rays that share a permutation");
+        let mut records = Vec::new();
+        for pack in self.packs {
+            for a in 0..PACKET {
+                for b in a + 1..PACKET {
+                    let pair = intersect_pack_pair::<I>(pack, &lanes, [a, b], [self.t_max[a], self.t_max[b]]);
+                    let (alone_a, alone_b) = (
+                        intersect_pack::<I>(pack, &lanes.pack_ray(a), self.t_max[a]),
+                        intersect_pack::<I>(pack, &lanes.pack_ray(b), self.t_max[b]),
+                    );
+                    let (pair_values, values_a, values_b) =
+                        (pair.values::<8>(), alone_a.values::<4>(), alone_b.values::<4>());
+                    let (mut in_pair, mut alone) = (Vec::new(), Vec::new());
+                    for lane in (0..8).filter(|lane| pair.lanes >> lane & 1 != 0) {
+                        let single = if lane < 4 { &values_a } else { &values_b };
+                        for value in 0..5 {
+                            in_pair.push((pair_values[value][lane] as f64).to_bits());
+                            alone.push((single[value][lane % 4] as f64).to_bits());
+                        }
+                    }
+                    records.push((
+                        (pair.lanes & 0xf, pair.lanes >> 4),
+                        (alone_a.lanes, alone_b.lanes),
+                        in_pair,
+                        alone,
+                    ));
+                }
+            }
+        }
+        records
+    }
+}
+
+/// The few rays that reach a leaf are tested two at a time, a pack's four triangles against
+/// each ray in one half of eight lanes: every pair finds, lane for lane and bit for bit, what
+/// each of its rays finds alone, on every SIMD path, limits included.
+#[test]
+fn a_pair_of_rays_finds_in_a_pack_what_each_finds_alone() {
+    let mut rng = Rng::new(17);
+    let packs: Vec<TrianglePack> = (0..40)
+        .map(|k| {
+            let triangles: Vec<[Vec3; 3]> = (0..1 + k % 4)
+                .map(|_| {
+                    let centre = Vec3::new(rng.uniform(-1.0, 1.0), rng.uniform(-1.0, 1.0), rng.uniform(-3.0, 3.0));
+                    [0; 3].map(|_| centre + rng.in_box(1.2))
+                })
+                .collect();
+            TrianglePack::new(k * 4, &triangles)
+        })
+        .collect();
+    let origin = Vec3::new(0.0, 0.0, 8.0);
+    let rays: Vec<Ray> = (0..PACKET)
+        .map(|_| {
+            Ray::new(
+                origin,
+                Vec3::new(rng.uniform(-0.15, 0.15), rng.uniform(-0.15, 0.15), -1.0),
+            )
+        })
+        .collect();
+    let mut t_max = [Real::INFINITY; PACKET];
+    (t_max[2], t_max[5]) = (8.5, 9.5);
+    let mut hits = 0;
+    for path in goldray::simd::available() {
+        let records = goldray::simd::dispatch_on(
+            path,
+            PairsAndSingles {
+                packs: &packs,
+                rays: &rays,
+                t_max: &t_max,
+            },
+        )
+        .unwrap_or_else(|e| panic!("{e}"));
+        for (in_pair, alone, pair_values, values) in records {
+            assert_eq!(in_pair, alone, "{path:?}: the lanes hit");
+            assert_eq!(pair_values, values, "{path:?}: the hits' values");
+            hits += (alone.0 | alone.1).count_ones();
+        }
+    }
+    assert!(hits > 100, "the rays hit too few triangles ({hits}) to test much");
 }

@@ -3,7 +3,7 @@
 //! ([`intersect_triangle_rays`], for packets). Lane by lane the operations are the one-ray
 //! test's, so every `t` and barycentric is what that test gives.
 
-use super::super::real::{R4, R8, Real, Vec3, edge8, gamma, narrow4, wide4};
+use super::super::real::{R4, R8, Real, Vec3, edge8, gamma, join4, narrow4, wide4};
 use super::super::Ray;
 use super::super::lanes;
 use super::*;
@@ -227,6 +227,53 @@ impl<I: Isa> RayLanes<I> {
             shear: [R4::<I>::splat(v[3][lane]), R4::<I>::splat(v[4][lane]), R4::<I>::splat(v[5][lane])],
         }
     }
+}
+
+/// Value `values[a]` in lanes 0–3 and `values[b]` in lanes 4–7.
+#[inline(always)]
+fn lane_pair<I: Isa>(values: &[Real; 8], [a, b]: [usize; 2]) -> R8<I> {
+    join4::<I>(R4::<I>::splat(values[a]), R4::<I>::splat(values[b]))
+}
+
+/// Vertex `v` of each triangle of `pack` twice over (lanes 0–3 and 4–7), relative to the
+/// origin of the pair's ray in each half, permuted and sheared.
+#[inline(always)]
+fn pair_vertex<I: Isa>(pack: &TrianglePack, axes: [usize; 3], origin: &[R8<I>; 3], shear: &[R8<I>; 3], v: usize) -> [R8<I>; 3] {
+    let corner = &pack.corners[v];
+    let qx = twice::<I>(&corner[axes[0]]) - origin[0];
+    let qy = twice::<I>(&corner[axes[1]]) - origin[1];
+    let qz = twice::<I>(&corner[axes[2]]) - origin[2];
+    [qx + shear[0] * qz, qy + shear[1] * qz, qz]
+}
+
+/// Four lanes repeated as eight.
+#[inline(always)]
+fn twice<I: Isa>(values: &[Real; 4]) -> R8<I> {
+    let lanes = R4::<I>::load(values);
+    join4::<I>(lanes, lanes)
+}
+
+/// [`intersect_pack`] of two rays of `rays` at once, lanes `pair[0]` and `pair[1]` with limits
+/// `t_max`: lanes 0–3 are the first ray against the pack's four triangles, lanes 4–7 the second.
+/// Lane by lane the operations of [`intersect_pack`], so each lane's hit is bit for bit that
+/// test's; one test of eight lanes where two of four would repeat the work done in `f32`.
+///
+/// A kernel: compile it only inside one (see `crate::simd`).
+#[inline(always)]
+pub fn intersect_pack_pair<I: Isa>(pack: &TrianglePack, rays: &RayLanes<I>, pair: [usize; 2], t_max: [Real; 2]) -> RayHits<I> {
+    let v = &rays.values;
+    let origin = [lane_pair::<I>(&v[0], pair), lane_pair::<I>(&v[1], pair), lane_pair::<I>(&v[2], pair)];
+    let shear = [lane_pair::<I>(&v[3], pair), lane_pair::<I>(&v[4], pair), lane_pair::<I>(&v[5], pair)];
+    let p0 = pair_vertex::<I>(pack, rays.axes, &origin, &shear, 0);
+    let p1 = pair_vertex::<I>(pack, rays.axes, &origin, &shear, 1);
+    let p2 = pair_vertex::<I>(pack, rays.axes, &origin, &shear, 2);
+    let (e0, e1, e2) = (
+        edge8::<I>(p1[0], p1[1], p2[0], p2[1]),
+        edge8::<I>(p2[0], p2[1], p0[0], p0[1]),
+        edge8::<I>(p0[0], p0[1], p1[0], p1[1]),
+    );
+    let t_max = join4::<I>(R4::<I>::splat(t_max[0]), R4::<I>::splat(t_max[1]));
+    finish_test([p0, p1, p2], [e0, e1, e2], shear[2], t_max, pack.live | pack.live << 4)
 }
 
 /// Vertex `v` of triangle `triangle` of `pack`, relative to each ray's origin, permuted and
