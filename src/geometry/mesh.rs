@@ -186,12 +186,12 @@ impl Mesh {
             return [None; PACKET];
         }
         // Gathered once for both set-ups, and the triangles' set-up made only for rays that
-        // make a packet: random rays fail the first and go their own ways.
+        // make a packet: random rays fail the first and go their own ways. One call of the
+        // interleaved traversal, which is inlined: two would compile it twice.
         let gathered = lanes::RayLanes::<I>::gather(rays);
-        let Some(slab) = PacketLanes::<I>::from_lanes(&gathered) else {
-            return self.closest_interleaved::<I>(rays, t_max);
-        };
-        let Some(triangle_rays) = RayLanes::<I>::from_lanes(&gathered) else {
+        let slab = PacketLanes::<I>::from_lanes(&gathered);
+        let triangle_rays = if slab.is_some() { RayLanes::<I>::from_lanes(&gathered) } else { None };
+        let (Some(slab), Some(triangle_rays)) = (slab, triangle_rays) else {
             return self.closest_interleaved::<I>(rays, t_max);
         };
         let mut nearest = NearestTriangles { mesh: self, rays: triangle_rays, closest: [None; PACKET] };
