@@ -383,17 +383,12 @@ mod tests {
         // operand, and the NaN against 0.0 gives 0.0, as the smallest lane and the largest.
         assert_eq!(portable[2], 0.0f32.to_bits() as u64);
         assert_eq!(portable[3], 0.0f32.to_bits() as u64);
-        #[cfg(target_arch = "x86_64")]
-        {
-            // SAFETY: each trampoline runs only where the processor supports it.
-            let results = [
-                x86::has_avx2().then(|| unsafe { x86::run_avx2(Folds) }),
-                #[cfg(feature = "avx512")]
-                x86::has_avx512().then(|| unsafe { x86::run_avx512(Folds) }),
-            ];
-            for result in results.into_iter().flatten() {
-                assert_eq!(result, portable);
-            }
+        for path in available() {
+            assert_eq!(
+                dispatch_on(path, Folds).expect("an available path"),
+                portable,
+                "{path:?}"
+            );
         }
     }
 

@@ -62,17 +62,30 @@ fn nearest_in_packs<I: Isa>(
         while lanes != 0 {
             let lane = lanes.trailing_zeros() as usize;
             lanes &= lanes - 1;
-            let (t, triangle) = (values[0][lane], pack.id(lane));
-            let nearer = match closest {
-                Some(best) => t < best.t || (t == best.t && triangle < best.triangle),
-                None => true,
-            };
-            if nearer {
-                let hit = lane_hit(&values, lane);
-                *t_limit = t;
-                *closest = Some(MeshHit { t, triangle, barycentrics: [hit.b0, hit.b1, hit.b2] });
-            }
+            keep_nearer(&values, lane, pack.id(lane), t_limit, closest);
         }
+    }
+}
+
+/// Keeps the hit in `lane` of `values` (on `triangle`) in `closest`, and its `t` in `t_limit`,
+/// when it is nearer than the hit kept: the smaller triangle index among hits at the same `t`.
+#[inline(always)]
+fn keep_nearer<const N: usize>(
+    values: &[[Real; N]; 5],
+    lane: usize,
+    triangle: u32,
+    t_limit: &mut Real,
+    closest: &mut Option<MeshHit>,
+) {
+    let t = values[0][lane];
+    let nearer = match closest {
+        Some(best) => t < best.t || (t == best.t && triangle < best.triangle),
+        None => true,
+    };
+    if nearer {
+        let hit = lane_hit(values, lane);
+        *t_limit = t;
+        *closest = Some(MeshHit { t, triangle, barycentrics: [hit.b0, hit.b1, hit.b2] });
     }
 }
 
@@ -150,16 +163,7 @@ impl<I: Isa> PacketVisitor<I> for NearestTriangles<'_, I> {
                 while lanes != 0 {
                     let lane = lanes.trailing_zeros() as usize;
                     lanes &= lanes - 1;
-                    let t = values[0][lane];
-                    let nearer = match &self.closest[lane] {
-                        Some(best) => t < best.t || (t == best.t && id < best.triangle),
-                        None => true,
-                    };
-                    if nearer {
-                        let hit = lane_hit(&values, lane);
-                        t_limit[lane] = t;
-                        self.closest[lane] = Some(MeshHit { t, triangle: id, barycentrics: [hit.b0, hit.b1, hit.b2] });
-                    }
+                    keep_nearer(&values, lane, id, &mut t_limit[lane], &mut self.closest[lane]);
                 }
             }
         }
@@ -187,16 +191,8 @@ impl<I: Isa> NearestTriangles<'_, I> {
             while lanes != 0 {
                 let lane = lanes.trailing_zeros() as usize;
                 lanes &= lanes - 1;
-                let (ray, t, triangle) = (pair[lane / 4], values[0][lane], pack.id(lane % 4));
-                let nearer = match &self.closest[ray] {
-                    Some(best) => t < best.t || (t == best.t && triangle < best.triangle),
-                    None => true,
-                };
-                if nearer {
-                    let hit = lane_hit(&values, lane);
-                    t_limit[ray] = t;
-                    self.closest[ray] = Some(MeshHit { t, triangle, barycentrics: [hit.b0, hit.b1, hit.b2] });
-                }
+                let ray = pair[lane / 4];
+                keep_nearer(&values, lane, pack.id(lane % 4), &mut t_limit[ray], &mut self.closest[ray]);
             }
         }
     }
