@@ -162,7 +162,6 @@ impl Mesh {
     /// # Panics
     /// If there are more than [`PACKET`] rays.
     pub fn intersect_packet(&self, rays: &[Ray], t_max: Real) -> [Option<MeshHit>; PACKET] {
-        assert!(rays.len() <= PACKET, "a packet holds at most {PACKET} rays");
         struct Closest<'a>(&'a Mesh, &'a [Ray], Real);
         impl Kernel for Closest<'_> {
             type Output = [Option<MeshHit>; PACKET];

@@ -78,6 +78,9 @@ impl LaneBoxes for BvhNode {
 pub(super) fn node_hits<I: Isa>(boxes: &impl LaneBoxes, ray: &SlabLanes<I>, t_limit: Real) -> (R8<I>, u32) {
     let mut t_enter = R8::<I>::splat(0.0);
     let mut t_exit = R8::<I>::splat(t_limit * BOX_SLACK);
+    // Axis by axis, each axis's planes decoded where used: decoding all six first, as a packet's
+    // `PacketLanes::entry_exit` does once per node, cost a random ray 6% more instructions in
+    // the interleaved walk.
     for axis in 0..3 {
         let negative = ray.negative[axis] as usize;
         let (near, far) = (boxes.planes::<I>(negative, axis), boxes.planes::<I>(1 - negative, axis));
