@@ -230,6 +230,11 @@ pub trait Lanes:
     fn store(self, out: &mut [Self::Elem]);
     fn sqrt(self) -> Self;
     fn abs(self) -> Self;
+    /// `self · factor + addend` for a product the caller knows to be exact (a power of two times
+    /// a small integer, say): then a fused multiply-add, one instruction on x86, and a
+    /// multiplication followed by an addition round once and alike, so every path has the same
+    /// bits. With an inexact product the paths may differ in the last place.
+    fn mul_add_exact(self, factor: Self, addend: Self) -> Self;
     /// `self > other ? self : other` per lane (x86's `max`): a NaN in either gives `other`.
     fn max(self, other: Self) -> Self;
     /// `self < other ? self : other` per lane (x86's `min`): a NaN in either gives `other`.

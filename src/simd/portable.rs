@@ -196,6 +196,13 @@ macro_rules! array_lanes {
                 self.each(<$t>::abs)
             }
             #[inline(always)]
+            fn mul_add_exact(self, factor: Self, addend: Self) -> Self {
+                // Unfused: exact products round once either way, and a fused multiply-add
+                // would be a library call where the processor has none.
+                let (a, b, c) = (self.0, factor.0, addend.0);
+                Array([$(a[$lane] * b[$lane] + c[$lane]),*])
+            }
+            #[inline(always)]
             fn max(self, other: Self) -> Self {
                 self.zip(other, |a, b| if a > b { a } else { b })
             }

@@ -164,7 +164,7 @@ macro_rules! register_lanes {
         $name:ident, $mask:ident, $reg:ty, $elem:ty, $n:expr,
         load: $load:ident, store: $store:ident, splat: $splat:ident,
         add: $add:ident, sub: $sub:ident, mul: $mul:ident, div: $div:ident, sqrt: $sqrt:ident,
-        max: $max:ident, min: $min:ident, and: $and:ident, or: $or:ident, andnot: $andnot:ident,
+        fmadd: $fmadd:ident, max: $max:ident, min: $min:ident, and: $and:ident, or: $or:ident, andnot: $andnot:ident,
         xor: $xor:ident, blend: $blend:ident, movemask: $movemask:ident,
         cmp: |$a:ident, $b:ident, $pred:ident| $cmp:expr,
         bits: $to_bits:ident, from_bits: $from_bits:ident, int_add: $int_add:ident, int_sub: $int_sub:ident,
@@ -271,6 +271,10 @@ macro_rules! register_lanes {
                 $name(unsafe { $andnot($splat(-0.0), self.0) })
             }
             #[inline(always)]
+            fn mul_add_exact(self, factor: Self, addend: Self) -> Self {
+                $name(unsafe { $fmadd(self.0, factor.0, addend.0) })
+            }
+            #[inline(always)]
             fn max(self, other: Self) -> Self {
                 $name(unsafe { $max(self.0, other.0) })
             }
@@ -328,7 +332,7 @@ register_lanes!(
     F32x4, M32x4, __m128, f32, 4,
     load: _mm_loadu_ps, store: _mm_storeu_ps, splat: _mm_set1_ps,
     add: _mm_add_ps, sub: _mm_sub_ps, mul: _mm_mul_ps, div: _mm_div_ps, sqrt: _mm_sqrt_ps,
-    max: _mm_max_ps, min: _mm_min_ps, and: _mm_and_ps, or: _mm_or_ps, andnot: _mm_andnot_ps,
+    fmadd: _mm_fmadd_ps, max: _mm_max_ps, min: _mm_min_ps, and: _mm_and_ps, or: _mm_or_ps, andnot: _mm_andnot_ps,
     xor: _mm_xor_ps, blend: _mm_blendv_ps, movemask: _mm_movemask_ps,
     cmp: |a, b, P| _mm_cmp_ps::<P>(a, b),
     bits: _mm_castps_si128, from_bits: _mm_castsi128_ps, int_add: _mm_add_epi32, int_sub: _mm_sub_epi32,
@@ -339,7 +343,7 @@ register_lanes!(
     F32x8, M32x8, __m256, f32, 8,
     load: _mm256_loadu_ps, store: _mm256_storeu_ps, splat: _mm256_set1_ps,
     add: _mm256_add_ps, sub: _mm256_sub_ps, mul: _mm256_mul_ps, div: _mm256_div_ps, sqrt: _mm256_sqrt_ps,
-    max: _mm256_max_ps, min: _mm256_min_ps, and: _mm256_and_ps, or: _mm256_or_ps, andnot: _mm256_andnot_ps,
+    fmadd: _mm256_fmadd_ps, max: _mm256_max_ps, min: _mm256_min_ps, and: _mm256_and_ps, or: _mm256_or_ps, andnot: _mm256_andnot_ps,
     xor: _mm256_xor_ps, blend: _mm256_blendv_ps, movemask: _mm256_movemask_ps,
     cmp: |a, b, P| _mm256_cmp_ps::<P>(a, b),
     bits: _mm256_castps_si256, from_bits: _mm256_castsi256_ps, int_add: _mm256_add_epi32, int_sub: _mm256_sub_epi32,
@@ -351,7 +355,7 @@ register_lanes!(
     F64x4, M64x4, __m256d, f64, 4,
     load: _mm256_loadu_pd, store: _mm256_storeu_pd, splat: _mm256_set1_pd,
     add: _mm256_add_pd, sub: _mm256_sub_pd, mul: _mm256_mul_pd, div: _mm256_div_pd, sqrt: _mm256_sqrt_pd,
-    max: _mm256_max_pd, min: _mm256_min_pd, and: _mm256_and_pd, or: _mm256_or_pd, andnot: _mm256_andnot_pd,
+    fmadd: _mm256_fmadd_pd, max: _mm256_max_pd, min: _mm256_min_pd, and: _mm256_and_pd, or: _mm256_or_pd, andnot: _mm256_andnot_pd,
     xor: _mm256_xor_pd, blend: _mm256_blendv_pd, movemask: _mm256_movemask_pd,
     cmp: |a, b, P| _mm256_cmp_pd::<P>(a, b),
     bits: _mm256_castpd_si256, from_bits: _mm256_castsi256_pd, int_add: _mm256_add_epi64, int_sub: _mm256_sub_epi64,
@@ -434,6 +438,13 @@ impl Lanes for F64x8 {
     #[inline(always)]
     fn abs(self) -> Self {
         F64x8([self.0[0].abs(), self.0[1].abs()])
+    }
+    #[inline(always)]
+    fn mul_add_exact(self, factor: Self, addend: Self) -> Self {
+        F64x8([
+            self.0[0].mul_add_exact(factor.0[0], addend.0[0]),
+            self.0[1].mul_add_exact(factor.0[1], addend.0[1]),
+        ])
     }
     #[inline(always)]
     fn max(self, other: Self) -> Self {

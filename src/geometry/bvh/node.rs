@@ -1,8 +1,10 @@
 //! The 8-wide tree's node: its children's boxes quantised to a byte per plane, rounded outward.
 //!
 //! Each axis of a node has an origin and a scale, a power of two, and each child's plane is
-//! `origin + q·scale` for a byte `q`, computed as the traversal computes it (an `as` conversion, a
-//! multiplication and an addition, each rounded once and identically on every SIMD path). The
+//! `origin + q·scale` for a byte `q`, computed as the traversal computes it: `q·scale` is exact
+//! (a power of two times a byte, never overflowing: see `quantise_axis`), so the addition is the
+//! only rounding, whether a path fuses the two (x86's multiply-add) or not, and every SIMD path
+//! gets the same plane. The
 //! build chooses every `q` by computing that very expression and checking it against the exact
 //! bound, so each stored box contains its child's exact box: a ray that enters the exact box
 //! enters the stored one, no sooner. Traversal then tests the stored boxes with the unchanged
@@ -114,13 +116,13 @@ impl BvhNode {
     #[inline(always)]
     pub(super) fn planes<I: Isa>(&self, side: usize, axis: usize) -> R8<I> {
         // Widened lane by lane into an array the compiler turns into one zero-extension and one
-        // conversion; then the same two roundings as `plane`.
+        // conversion; then `plane`'s one rounding (its product is exact).
         let bytes = &self.planes[side][axis];
         let mut codes = [0.0; WIDTH];
         for lane in 0..WIDTH {
             codes[lane] = bytes[lane] as Real;
         }
-        R8::<I>::load(&codes) * R8::<I>::splat(self.scale[axis]) + R8::<I>::splat(self.origin[axis])
+        R8::<I>::load(&codes).mul_add_exact(R8::<I>::splat(self.scale[axis]), R8::<I>::splat(self.origin[axis]))
     }
 
     /// A bit per slot holding a child whose box is not empty.
@@ -147,7 +149,8 @@ impl BvhNode {
     }
 }
 
-/// The plane of `code`, rounded exactly as [`BvhNode::planes`] rounds it.
+/// The plane of `code`, rounded exactly as [`BvhNode::planes`] rounds it: once, in the addition,
+/// since `quantise_axis` only chooses scales whose products with a byte are exact.
 #[inline]
 fn plane(origin: Real, scale: Real, code: u8) -> Real {
     code as Real * scale + origin
@@ -167,9 +170,11 @@ fn quantise_axis(min: &[Real; WIDTH], max: &[Real; WIDTH]) -> Option<(Real, Real
     }
     // The smallest power of two with 255 steps covering the extent (at least the smallest
     // subnormal, a power of two, when the division underflows); twice that when the rounding of
-    // the planes leaves an upper bound uncovered, and none when no finite one covers it.
+    // the planes leaves an upper bound uncovered, and none when 255 steps would overflow. A
+    // power of two at or above the smallest subnormal times a byte is then exact, so a plane
+    // rounds once however a path computes it (see `plane`).
     let mut scale = if extent > 0.0 { smallest_power_of_two_at_least(extent / TOP).max(Real::from_bits(1)) } else { 0.0 };
-    while scale.is_finite() {
+    while (scale * TOP).is_finite() {
         let (mut lower, mut upper) = ([0; WIDTH], [0; WIDTH]);
         for lane in 0..WIDTH {
             // The truncated quotient, one lower if the plane's rounding put it above; code 0
@@ -217,6 +222,9 @@ mod tests {
             -1e-3 as Real..1e-3 as Real,
             -1e-37 as Real..1e-37 as Real,
             (1e6 as Real..1e7 as Real),
+            // Extents whose 255 steps would overflow a power of two's scale.
+            (1e36 as Real..1e38 as Real),
+            (-1e38 as Real..-1e36 as Real),
             Just(0.0 as Real),
         ]
     }
@@ -243,6 +251,44 @@ mod tests {
             for (lane, exact) in boxes.iter().enumerate() {
                 let stored = node.child_bounds(lane);
                 prop_assert!(contains(&stored, exact), "lane {lane}: {stored:?} does not contain {exact:?}");
+            }
+        }
+    }
+
+    /// A node's planes as the traversal decodes them on `I`'s path, by side, axis and lane.
+    struct DecodedPlanes<'a>(&'a BvhNode);
+
+    impl crate::simd::Kernel for DecodedPlanes<'_> {
+        type Output = [[[Real; WIDTH]; 3]; 2];
+        fn run<I: Isa>(self) -> Self::Output {
+            let mut planes = [[[0.0; WIDTH]; 3]; 2];
+            for (side, planes) in planes.iter_mut().enumerate() {
+                for (axis, planes) in planes.iter_mut().enumerate() {
+                    self.0.planes::<I>(side, axis).store(planes);
+                }
+            }
+            planes
+        }
+    }
+
+    proptest! {
+        /// The traversal's planes are the ones the build checked against the exact bounds
+        /// (`plane`, through `child_bounds`), bit for bit on every SIMD path, whether the path
+        /// fuses the multiplication and the addition or not.
+        #[test]
+        fn decoded_planes_are_the_checked_ones_on_every_path(boxes in prop::collection::vec(aabb(), 1..=WIDTH)) {
+            let children: Vec<Child> = boxes.iter().map(|&bounds| Child { bounds, index: 0, count: 1 }).collect();
+            let node = BvhNode::new(&children);
+            for path in crate::simd::available() {
+                let decoded = crate::simd::dispatch_on(path, DecodedPlanes(&node)).unwrap();
+                for lane in 0..boxes.len() {
+                    let checked = node.child_bounds(lane);
+                    for axis in 0..3 {
+                        let (min, max) = (decoded[0][axis][lane], decoded[1][axis][lane]);
+                        prop_assert_eq!(min.to_bits(), checked.min[axis].to_bits(), "{:?} lane {} axis {}", path, lane, axis);
+                        prop_assert_eq!(max.to_bits(), checked.max[axis].to_bits(), "{:?} lane {} axis {}", path, lane, axis);
+                    }
+                }
             }
         }
     }
