@@ -2,20 +2,10 @@
 
 instantiate!(f32, glam::Vec2, glam::Vec3, glam::Mat3, glam::Mat4);
 
-/// Lanes of `Real` for the SIMD kernels (`crate::simd`), and the exact widening to `f64` that the
-/// triangle test's edge functions use.
+/// Lanes of `Real` for the SIMD kernels (`crate::simd`); the triangle test's edge functions
+/// widen them to `f64`, where their products are exact.
 pub type R4<I> = <I as crate::simd::Isa>::F32x4;
 pub type R8<I> = <I as crate::simd::Isa>::F32x8;
-
-#[inline(always)]
-pub fn wide4<I: crate::simd::Isa>(x: R4<I>) -> I::F64x4 {
-    I::widen(x)
-}
-
-#[inline(always)]
-pub fn narrow4<I: crate::simd::Isa>(x: I::F64x4) -> R4<I> {
-    I::narrow(x)
-}
 
 /// Four lanes and four more as eight.
 #[inline(always)]
@@ -31,7 +21,11 @@ pub fn edge8<I: crate::simd::Isa>(ax: R8<I>, ay: R8<I>, bx: R8<I>, by: R8<I>) ->
     I::join(edge4::<I>(ax0, ay0, bx0, by0), edge4::<I>(ax1, ay1, bx1, by1))
 }
 
+/// The triangle test's edge function on four lanes, as [`edge8`]. Both products are exact in
+/// `f64`, so fusing the first with the subtraction leaves the subtraction the one rounding
+/// before the narrowing, as `edge_function`'s.
 #[inline(always)]
-fn edge4<I: crate::simd::Isa>(ax: I::F32x4, ay: I::F32x4, bx: I::F32x4, by: I::F32x4) -> I::F32x4 {
-    I::narrow(I::widen(ax) * I::widen(by) - I::widen(ay) * I::widen(bx))
+pub fn edge4<I: crate::simd::Isa>(ax: R4<I>, ay: R4<I>, bx: R4<I>, by: R4<I>) -> R4<I> {
+    use crate::simd::Lanes;
+    I::narrow(I::widen(ax).mul_add_exact(I::widen(by), -(I::widen(ay) * I::widen(bx))))
 }

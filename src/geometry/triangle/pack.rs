@@ -3,7 +3,7 @@
 //! ([`intersect_triangle_rays`], for packets). Lane by lane the operations are the one-ray
 //! test's, so every `t` and barycentric is what that test gives.
 
-use super::super::real::{R4, R8, Real, Vec3, edge8, gamma, join4, narrow4, wide4};
+use super::super::real::{R4, R8, Real, Vec3, edge4, edge8, gamma, join4};
 use super::super::Ray;
 use super::super::lanes;
 use super::*;
@@ -147,7 +147,7 @@ fn pack_vertex<I: Isa>(pack: &TrianglePack, ray: &PackRay<I>, v: usize) -> [R4<I
 /// [`edge_function`] on four lanes.
 #[inline(always)]
 fn pack_edge<I: Isa>(a: &[R4<I>; 3], b: &[R4<I>; 3]) -> R4<I> {
-    narrow4::<I>(wide4::<I>(a[0]) * wide4::<I>(b[1]) - wide4::<I>(a[1]) * wide4::<I>(b[0]))
+    edge4::<I>(a[0], a[1], b[0], b[1])
 }
 
 /// `max(|a|, max(|b|, |c|))` per lane (`Vec3::abs().max_element()`).
