@@ -279,14 +279,15 @@ mod tests {
         fn decoded_planes_are_the_checked_ones_on_every_path(boxes in prop::collection::vec(aabb(), 1..=WIDTH)) {
             let children: Vec<Child> = boxes.iter().map(|&bounds| Child { bounds, index: 0, count: 1 }).collect();
             let node = BvhNode::new(&children);
+            let checked: Vec<Aabb> = (0..boxes.len()).map(|lane| node.child_bounds(lane)).collect();
             for path in crate::simd::available() {
                 let decoded = crate::simd::dispatch_on(path, DecodedPlanes(&node)).unwrap();
-                for lane in 0..boxes.len() {
-                    let checked = node.child_bounds(lane);
-                    for axis in 0..3 {
-                        let (min, max) = (decoded[0][axis][lane], decoded[1][axis][lane]);
-                        prop_assert_eq!(min.to_bits(), checked.min[axis].to_bits(), "{:?} lane {} axis {}", path, lane, axis);
-                        prop_assert_eq!(max.to_bits(), checked.max[axis].to_bits(), "{:?} lane {} axis {}", path, lane, axis);
+                for (side, planes) in decoded.iter().enumerate() {
+                    for (axis, lanes) in planes.iter().enumerate() {
+                        for (lane, (plane, bounds)) in lanes.iter().zip(&checked).enumerate() {
+                            let expected = if side == 0 { bounds.min[axis] } else { bounds.max[axis] };
+                            prop_assert_eq!(plane.to_bits(), expected.to_bits(), "{:?} side {} axis {} lane {}", path, side, axis, lane);
+                        }
                     }
                 }
             }
