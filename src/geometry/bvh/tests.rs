@@ -491,3 +491,94 @@ fn a_packets_frustum_keeps_every_box_a_ray_enters_and_culls_others() {
         }
     }
 }
+
+/// `a/b ≤ c/d` for positive denominators.
+fn ratio_le((a, b): (i64, i64), (c, d): (i64, i64)) -> bool {
+    a * d <= c * b
+}
+
+/// Whether the ray meets the box for some `t` in `[0, t_limit]`, in exact rational arithmetic
+/// (every coordinate an integer, so every distance a ratio of integers).
+fn enters_exactly(origin: [i64; 3], direction: [i64; 3], min: [i64; 3], max: [i64; 3], t_limit: Option<i64>) -> bool {
+    let (mut enter, mut exit) = ((0, 1), t_limit.map(|t| (t, 1)));
+    for axis in 0..3 {
+        let (o, d) = (origin[axis], direction[axis]);
+        if d == 0 {
+            if o < min[axis] || o > max[axis] {
+                return false;
+            }
+            continue;
+        }
+        let (near, far) = if d > 0 { (min[axis], max[axis]) } else { (max[axis], min[axis]) };
+        let (near, far) = ((d.signum() * (near - o), d.abs()), (d.signum() * (far - o), d.abs()));
+        if ratio_le(enter, near) {
+            enter = near;
+        }
+        if exit.is_none_or(|exit| ratio_le(far, exit)) {
+            exit = Some(far);
+        }
+    }
+    exit.is_none_or(|exit| ratio_le(enter, exit))
+}
+
+struct SlabTest<'a> {
+    boxes: &'a BoxSet,
+    ray: Ray,
+    t_limit: Real,
+}
+
+impl crate::simd::Kernel for SlabTest<'_> {
+    type Output = u32;
+    fn run<I: Isa>(self) -> u32 {
+        self.boxes.entered::<I>(&self.ray, self.t_limit).0
+    }
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(2048))]
+    /// The slab test never misses a box the ray meets exactly, on every path: boxes whose
+    /// faces, edges and corners the ray grazes (planes through points of the ray at whole `t`),
+    /// zero direction components (infinite inverses, origins on a plane), inverses that round
+    /// (directions of 3 and 7), origins far from the boxes, where the differences round the
+    /// most, and limits that end on a face.
+    #[test]
+    fn the_slab_test_never_misses_a_box_the_ray_meets_exactly(
+        origin in proptest::array::uniform3(-8i64..=8),
+        far_origin in proptest::bool::ANY,
+        direction in proptest::array::uniform3(proptest::sample::select(vec![-13i64, -7, -3, -1, 0, 0, 1, 3, 5, 6, 9, 11])),
+        corners in proptest::collection::vec(
+            proptest::array::uniform3((-6i64..=6, proptest::sample::select(vec![-2i64, -1, 0, 0, 0, 1, 2]))),
+            16,
+        ),
+        t_limit in proptest::option::of(0i64..=6),
+    ) {
+        // Far origins step back along the ray (a million units), keeping the boxes on its path.
+        let back = if far_origin { 1 << 20 } else { 0 };
+        let origin = [0, 1, 2].map(|axis| origin[axis] - back * direction[axis]);
+        let t_limit = t_limit.map(|t| t + back);
+        // A corner is a point of the ray at whole `t`, moved by a few units on each axis.
+        let point = |[(t, nudge_x), (_, nudge_y), (_, nudge_z)]: [(i64, i64); 3]| {
+            let t = t.abs() + back;
+            [0, 1, 2].map(|axis| origin[axis] + t * direction[axis] + [nudge_x, nudge_y, nudge_z][axis])
+        };
+        let boxes: Vec<([i64; 3], [i64; 3])> = corners
+            .chunks_exact(2)
+            .map(|pair| {
+                let (a, b) = (point(pair[0]), point(pair[1]));
+                ([0, 1, 2].map(|axis| a[axis].min(b[axis])), [0, 1, 2].map(|axis| a[axis].max(b[axis])))
+            })
+            .collect();
+        let real = |v: [i64; 3]| Vec3::new(v[0] as Real, v[1] as Real, v[2] as Real);
+        let set = BoxSet::new(&boxes.iter().map(|&(min, max)| Aabb::new(real(min), real(max))).collect::<Vec<_>>());
+        let ray = Ray::new(real(origin), real(direction));
+        let limit = t_limit.map_or(Real::INFINITY, |t| t as Real);
+        for path in crate::simd::available() {
+            let hits = crate::simd::dispatch_on(path, SlabTest { boxes: &set, ray, t_limit: limit }).unwrap();
+            for (lane, &(min, max)) in boxes.iter().enumerate() {
+                if enters_exactly(origin, direction, min, max, t_limit) {
+                    proptest::prop_assert!(hits >> lane & 1 != 0, "{:?}: box {:?}–{:?} missed", path, min, max);
+                }
+            }
+        }
+    }
+}
