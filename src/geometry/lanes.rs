@@ -215,7 +215,13 @@ impl<I: Isa> RayLanes<I> {
             (axes[0][0][lane], axes[0][1][lane], axes[0][2][lane]) = (o.x, o.y, o.z);
             (axes[1][0][lane], axes[1][1][lane], axes[1][2][lane]) = (d.x, d.y, d.z);
         }
-        RayLanes { origin: V3::load(&axes[0]), direction: V3::load(&axes[1]) }
+        // Put into lanes as values: loaded from the array, each lane would wait for the eight
+        // writes before it (a load cannot take its value from several smaller writes).
+        let [o, d] = axes;
+        RayLanes {
+            origin: V3 { x: R8::<I>::from_array(o[0]), y: R8::<I>::from_array(o[1]), z: R8::<I>::from_array(o[2]) },
+            direction: V3 { x: R8::<I>::from_array(d[0]), y: R8::<I>::from_array(d[1]), z: R8::<I>::from_array(d[2]) },
+        }
     }
 
     /// A bit per lane whose origin and direction are finite.

@@ -227,6 +227,13 @@ pub trait Lanes:
     fn splat(value: Self::Elem) -> Self;
     /// The first `N` values of `values`.
     fn load(values: &[Self::Elem]) -> Self;
+    /// The `N` values, put into lanes where they are (in registers on x86) rather than read
+    /// back from memory as [`Lanes::load`] does: values just written one by one would wait for
+    /// those writes before the load could read them.
+    ///
+    /// # Panics
+    /// If `M` is not `N`.
+    fn from_array<const M: usize>(values: [Self::Elem; M]) -> Self;
     fn store(self, out: &mut [Self::Elem]);
     fn sqrt(self) -> Self;
     fn abs(self) -> Self;
@@ -317,6 +324,51 @@ mod tests {
                 sums,
                 x.lt(I::F32x4::splat(2.0)).and_not(x.eq(x.abs())).bits(),
             )
+        }
+    }
+
+    /// Each lane type's `from_array` and `load` of the same values, stored back, as bits.
+    struct FromArray;
+
+    impl Kernel for FromArray {
+        type Output = [Vec<u64>; 2];
+        fn run<I: Isa>(self) -> Self::Output {
+            let v = [
+                1.5f32,
+                -0.0,
+                f32::NAN,
+                f32::INFINITY,
+                1.0e-40,
+                -7.0,
+                3.25,
+                f32::MIN_POSITIVE,
+            ];
+            let w = v.map(f64::from);
+            let (mut f4, mut f8, mut d4, mut d8) = ([0.0; 4], [0.0; 8], [0.0; 4], [0.0; 8]);
+            let mut from_array = Vec::new();
+            I::F32x4::from_array([v[0], v[1], v[2], v[3]]).store(&mut f4);
+            I::F32x8::from_array(v).store(&mut f8);
+            I::F64x4::from_array([w[4], w[5], w[6], w[7]]).store(&mut d4);
+            I::F64x8::from_array(w).store(&mut d8);
+            from_array.extend(f4.iter().chain(&f8).map(|x| x.to_bits() as u64));
+            from_array.extend(d4.iter().chain(&d8).map(|x| x.to_bits()));
+            let mut loaded = Vec::new();
+            I::F32x4::load(&v).store(&mut f4);
+            I::F32x8::load(&v).store(&mut f8);
+            I::F64x4::load(&w[4..]).store(&mut d4);
+            I::F64x8::load(&w).store(&mut d8);
+            loaded.extend(f4.iter().chain(&f8).map(|x| x.to_bits() as u64));
+            loaded.extend(d4.iter().chain(&d8).map(|x| x.to_bits()));
+            [from_array, loaded]
+        }
+    }
+
+    #[test]
+    fn values_put_into_lanes_are_the_values_loaded_on_every_path() {
+        for path in available() {
+            let [from_array, loaded] = dispatch_on(path, FromArray).unwrap();
+            assert_eq!(from_array, loaded, "{path:?}");
+            assert_eq!(from_array[4 + 4], 1.0e-40f32.to_bits() as u64, "{path:?}: lanes in order");
         }
     }
 

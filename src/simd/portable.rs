@@ -188,6 +188,11 @@ macro_rules! array_lanes {
                 out[..$n].copy_from_slice(&self.0);
             }
             #[inline(always)]
+            fn from_array<const M: usize>(values: [$t; M]) -> Self {
+                assert_eq!(M, $n, "{} values for {} lanes", M, $n);
+                Array([$(values[$lane]),*])
+            }
+            #[inline(always)]
             fn sqrt(self) -> Self {
                 self.each(<$t>::sqrt)
             }

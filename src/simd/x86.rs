@@ -162,7 +162,7 @@ unsafe fn fold4_pd(
 macro_rules! register_lanes {
     (
         $name:ident, $mask:ident, $reg:ty, $elem:ty, $n:expr,
-        load: $load:ident, store: $store:ident, splat: $splat:ident,
+        load: $load:ident, store: $store:ident, splat: $splat:ident, setr: $setr:ident [$($lane:literal),*],
         add: $add:ident, sub: $sub:ident, mul: $mul:ident, div: $div:ident, sqrt: $sqrt:ident,
         fmadd: $fmadd:ident, max: $max:ident, min: $min:ident, and: $and:ident, or: $or:ident, andnot: $andnot:ident,
         xor: $xor:ident, blend: $blend:ident, movemask: $movemask:ident,
@@ -263,6 +263,11 @@ macro_rules! register_lanes {
                 unsafe { $store(out.as_mut_ptr(), self.0) }
             }
             #[inline(always)]
+            fn from_array<const M: usize>(values: [$elem; M]) -> Self {
+                assert_eq!(M, $n, "{} values for {} lanes", M, $n);
+                $name(unsafe { $setr($(values[$lane]),*) })
+            }
+            #[inline(always)]
             fn sqrt(self) -> Self {
                 $name(unsafe { $sqrt(self.0) })
             }
@@ -330,7 +335,7 @@ macro_rules! register_lanes {
 
 register_lanes!(
     F32x4, M32x4, __m128, f32, 4,
-    load: _mm_loadu_ps, store: _mm_storeu_ps, splat: _mm_set1_ps,
+    load: _mm_loadu_ps, store: _mm_storeu_ps, splat: _mm_set1_ps, setr: _mm_setr_ps [0, 1, 2, 3],
     add: _mm_add_ps, sub: _mm_sub_ps, mul: _mm_mul_ps, div: _mm_div_ps, sqrt: _mm_sqrt_ps,
     fmadd: _mm_fmadd_ps, max: _mm_max_ps, min: _mm_min_ps, and: _mm_and_ps, or: _mm_or_ps, andnot: _mm_andnot_ps,
     xor: _mm_xor_ps, blend: _mm_blendv_ps, movemask: _mm_movemask_ps,
@@ -342,6 +347,7 @@ register_lanes!(
 register_lanes!(
     F32x8, M32x8, __m256, f32, 8,
     load: _mm256_loadu_ps, store: _mm256_storeu_ps, splat: _mm256_set1_ps,
+    setr: _mm256_setr_ps [0, 1, 2, 3, 4, 5, 6, 7],
     add: _mm256_add_ps, sub: _mm256_sub_ps, mul: _mm256_mul_ps, div: _mm256_div_ps, sqrt: _mm256_sqrt_ps,
     fmadd: _mm256_fmadd_ps, max: _mm256_max_ps, min: _mm256_min_ps, and: _mm256_and_ps, or: _mm256_or_ps, andnot: _mm256_andnot_ps,
     xor: _mm256_xor_ps, blend: _mm256_blendv_ps, movemask: _mm256_movemask_ps,
@@ -353,7 +359,7 @@ register_lanes!(
 
 register_lanes!(
     F64x4, M64x4, __m256d, f64, 4,
-    load: _mm256_loadu_pd, store: _mm256_storeu_pd, splat: _mm256_set1_pd,
+    load: _mm256_loadu_pd, store: _mm256_storeu_pd, splat: _mm256_set1_pd, setr: _mm256_setr_pd [0, 1, 2, 3],
     add: _mm256_add_pd, sub: _mm256_sub_pd, mul: _mm256_mul_pd, div: _mm256_div_pd, sqrt: _mm256_sqrt_pd,
     fmadd: _mm256_fmadd_pd, max: _mm256_max_pd, min: _mm256_min_pd, and: _mm256_and_pd, or: _mm256_or_pd, andnot: _mm256_andnot_pd,
     xor: _mm256_xor_pd, blend: _mm256_blendv_pd, movemask: _mm256_movemask_pd,
@@ -430,6 +436,14 @@ impl Lanes for F64x8 {
     fn store(self, out: &mut [f64]) {
         self.0[0].store(&mut out[..4]);
         self.0[1].store(&mut out[4..8]);
+    }
+    #[inline(always)]
+    fn from_array<const M: usize>(values: [f64; M]) -> Self {
+        assert_eq!(M, 8, "{M} values for 8 lanes");
+        F64x8([
+            F64x4::from_array([values[0], values[1], values[2], values[3]]),
+            F64x4::from_array([values[4], values[5], values[6], values[7]]),
+        ])
     }
     #[inline(always)]
     fn sqrt(self) -> Self {
