@@ -368,7 +368,11 @@ mod tests {
         for path in available() {
             let [from_array, loaded] = dispatch_on(path, FromArray).unwrap();
             assert_eq!(from_array, loaded, "{path:?}");
-            assert_eq!(from_array[4 + 4], 1.0e-40f32.to_bits() as u64, "{path:?}: lanes in order");
+            assert_eq!(
+                from_array[4 + 4],
+                1.0e-40f32.to_bits() as u64,
+                "{path:?}: lanes in order"
+            );
         }
     }
 
