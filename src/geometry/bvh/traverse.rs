@@ -170,6 +170,14 @@ impl<'a, T: Copy> Stack<'a, T> {
         self.len += 1;
     }
 
+    /// Pushes `entry` when `keep`, without a branch: the entry is written either way, in the
+    /// room the next push would use.
+    #[inline(always)]
+    pub(super) fn push_if(&mut self, entry: T, keep: bool) {
+        self.entries[self.len] = MaybeUninit::new(entry);
+        self.len += keep as usize;
+    }
+
     #[inline(always)]
     pub(super) fn pop(&mut self) -> Option<T> {
         if self.len == 0 {
@@ -328,20 +336,18 @@ fn nearest_child<I: Isa>(
     stack: &mut Stack<'_, Pending>,
     visitor: &impl LeafVisitor<I>,
 ) -> Pending {
-    let first = hits.trailing_zeros() as usize;
-    let rest = hits & (hits - 1);
-    if rest == 0 {
-        return Pending { t: 0.0, index: node.child[first], count: node.count[first] as u32 };
-    }
     let mut t = [0.0; WIDTH];
     t_enter.store(&mut t);
     let child = |lane: usize| Pending { t: t[lane], index: node.child[lane], count: node.count[lane] as u32 };
-    if rest & (rest - 1) == 0 {
-        // Two children, the common case: the farther one waits.
-        let second = rest.trailing_zeros() as usize;
-        let (near, far) = if t[second] < t[first] { (second, first) } else { (first, second) };
+    let first = hits.trailing_zeros() as usize;
+    let rest = hits & (hits - 1);
+    if rest & rest.wrapping_sub(1) == 0 {
+        // One child or two, the common cases, without a branch between them (which is which
+        // is as unpredictable as a coin): with one, `last` is `first` and nothing waits.
+        let last = (u32::BITS - 1 - hits.leading_zeros()) as usize;
+        let (near, far) = if t[last] < t[first] { (last, first) } else { (first, last) };
         fetch::<I>(nodes, &child(far), visitor);
-        stack.push(child(far));
+        stack.push_if(child(far), rest != 0);
         return child(near);
     }
     // More: sort keys that order by entry distance and carry the lane, nearest first.
