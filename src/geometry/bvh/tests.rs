@@ -582,3 +582,23 @@ proptest::proptest! {
         }
     }
 }
+
+#[test]
+fn nearest_first_orders_every_set_of_entered_boxes_by_distance_then_lane() {
+    // Distances with ties (the lane decides), zero and the largest finite one; every set of
+    // entered lanes.
+    let distance_sets: [[Real; WIDTH]; 3] = [
+        [3.0, 1.0, 2.0, 0.5, 7.0, 0.25, 6.0, 4.0],
+        [1.0, 1.0, 0.0, 2.0, 0.0, Real::MAX, 1.0, 2.0],
+        [8.0, 7.0, 6.0, 5.0, 4.0, 3.0, 2.0, 1.0],
+    ];
+    for t in &distance_sets {
+        for hits in 0..=u8::MAX as u32 {
+            let (keys, count) = BoxSet::nearest_first(hits, t);
+            let lanes: Vec<usize> = keys[..count].iter().map(|&key| BoxSet::lane(key)).collect();
+            let mut expected: Vec<usize> = (0..WIDTH).filter(|&lane| hits >> lane & 1 != 0).collect();
+            expected.sort_by(|&a, &b| t[a].total_cmp(&t[b]).then(a.cmp(&b)));
+            assert_eq!(lanes, expected, "hits {hits:08b}, distances {t:?}");
+        }
+    }
+}
