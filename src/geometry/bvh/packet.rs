@@ -199,8 +199,8 @@ pub fn traverse_packet<I: Isa>(
     let mut current = PacketPending { t: 0.0, index: 0, count: 0, rays };
     // The farthest any ray may still reach, for the frustum's test; it changes only at leaves.
     let mut reach = (R8::<I>::load(&t_limit[..]) * R8::<I>::splat(BOX_SLACK)).max_lane();
-    // A node's entered children, nearest first; only the first `hit` are meaningful, so the
-    // array is filled once, not for every node.
+    // A node's entered children, in slot order until ordered below; only the first `hit` are
+    // meaningful, so the array is filled once, not for every node.
     let mut children = [(0u64, 0u32); WIDTH];
     loop {
         if current.count == 0 {
@@ -264,14 +264,8 @@ pub fn traverse_packet<I: Isa>(
                         }
                         nearest
                     };
-                    // Sorted by the key, nearest first; the low bits carry the slot.
-                    let mut k = hit;
-                    let key = sort_key(nearest, slot);
-                    while k > 0 && children[k - 1].0 > key {
-                        children[k] = children[k - 1];
-                        k -= 1;
-                    }
-                    children[k] = (key, entered);
+                    // The key orders by the entry; its low bits carry the slot.
+                    children[hit] = (sort_key(nearest, slot), entered);
                     hit += 1;
                 }
             }
@@ -281,12 +275,26 @@ pub fn traverse_packet<I: Isa>(
                     let t = Real::from_bits_key(key);
                     PacketPending { t, index: node.child[slot], count: node.count[slot] as u32, rays }
                 };
-                for &child in children[1..hit].iter().rev() {
-                    let waiting = pending(child);
+                if hit <= 2 {
+                    // One child or two, the common cases, without a branch on which is nearer
+                    // (a coin toss) or on how many: with one, `last` is the first and nothing
+                    // waits.
+                    let last = hit - 1;
+                    let swap = children[last].0 < children[0].0;
+                    let (near, far) = if swap { (last, 0) } else { (0, last) };
+                    let waiting = pending(children[far]);
                     fetch::<I>(nodes, &waiting, visitor);
-                    stack.push(waiting);
+                    stack.push_if(waiting, hit == 2);
+                    current = pending(children[near]);
+                } else {
+                    insertion_sort(&mut children[..hit]);
+                    for &child in children[1..hit].iter().rev() {
+                        let waiting = pending(child);
+                        fetch::<I>(nodes, &waiting, visitor);
+                        stack.push(waiting);
+                    }
+                    current = pending(children[0]);
                 }
-                current = pending(children[0]);
                 continue;
             }
         } else {
@@ -303,6 +311,20 @@ pub fn traverse_packet<I: Isa>(
                 break;
             }
         }
+    }
+}
+
+/// Sorts `children` by key, nearest first (three to eight of them: few enough for insertion).
+#[inline(always)]
+fn insertion_sort(children: &mut [(u64, u32)]) {
+    for next in 1..children.len() {
+        let child = children[next];
+        let mut k = next;
+        while k > 0 && children[k - 1].0 > child.0 {
+            children[k] = children[k - 1];
+            k -= 1;
+        }
+        children[k] = child;
     }
 }
 
