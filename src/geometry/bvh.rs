@@ -64,10 +64,17 @@ pub enum Visit {
 pub trait LeafVisitor<I: Isa> {
     fn leaf(&mut self, first: u32, count: u32, t_limit: &mut Real) -> Visit;
 
-    /// Called when a leaf is put on the traversal stack, so that its primitives can be asked
-    /// for from memory while the nearer children are visited (a hint: it must change nothing).
+    /// How many cache lines a leaf's primitives span from the line they start in, at most,
+    /// counting from [`LeafVisitor::leaf_data`]; zero for a visitor with nothing to fetch.
+    const LEAF_LINES: usize = 0;
+
+    /// Where the primitives of the leaf starting at `first` lie, so that they can be asked for
+    /// from memory while the nearer children are visited (a hint: never read through, so any
+    /// address will do, and asking must change nothing).
     #[inline(always)]
-    fn prefetch(&self, _first: u32, _count: u32) {}
+    fn leaf_data(&self, _first: u32) -> *const u8 {
+        std::ptr::null()
+    }
 }
 
 /// A closure as a [`LeafVisitor`], for visitors that use no lanes themselves.

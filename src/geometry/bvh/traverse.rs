@@ -189,16 +189,36 @@ impl<'a, T: Copy> Stack<'a, T> {
     }
 }
 
-/// A child that waits on the stack is fetched from memory meanwhile: a node here, a leaf's
-/// primitives by the visitor.
+/// A child that waits on the stack is fetched from memory meanwhile: a node, or the start of a
+/// leaf's primitives (where the visitor says they lie). The address is chosen by a select, not
+/// a branch (whether a child is a node or a leaf is not predictable), and the same number of
+/// lines asked for either way: a node's or a leaf's, whichever is more. A visitor with nothing
+/// to fetch has its leaves passed over (its null address is not asked for).
 #[inline(always)]
-fn fetch<I: Isa>(nodes: &[BvhNode], pending: &Pending, visitor: &impl LeafVisitor<I>) {
-    if pending.count == 0 {
-        prefetch_node::<I>(nodes, pending.index);
-    } else {
-        visitor.prefetch(pending.index, pending.count);
+fn fetch<I: Isa, V: LeafVisitor<I>>(nodes: &[BvhNode], pending: &Pending, visitor: &V) {
+    let node = nodes.as_ptr().wrapping_add(pending.index as usize).cast::<u8>();
+    if V::LEAF_LINES == 0 {
+        if pending.count == 0 {
+            prefetch_lines::<I>(node, NODE_LINES);
+        }
+        return;
+    }
+    let leaf = visitor.leaf_data(pending.index);
+    let start = if pending.count == 0 { node } else { leaf };
+    prefetch_lines::<I>(start, NODE_LINES.max(V::LEAF_LINES));
+}
+
+/// Asks for `lines` cache lines from the one `start` lies in.
+#[inline(always)]
+fn prefetch_lines<I: Isa>(start: *const u8, lines: usize) {
+    let line = start.wrapping_sub(start as usize % 64);
+    for k in 0..lines {
+        I::prefetch(line.wrapping_add(64 * k));
     }
 }
+
+/// The cache lines of a node.
+const NODE_LINES: usize = size_of::<BvhNode>().div_ceil(64);
 
 /// Asks for the cache lines of node `index`.
 #[inline(always)]
@@ -307,7 +327,7 @@ impl<'a, I: Isa> Walk<'a, I> {
             if hits != 0 {
                 self.current = nearest_child::<I>(node, t_enter, hits, nodes, &mut self.stack, visitor);
                 if AHEAD {
-                    fetch::<I>(nodes, &self.current, visitor);
+                    fetch::<I, _>(nodes, &self.current, visitor);
                 }
                 return true;
             }
@@ -346,7 +366,7 @@ fn nearest_child<I: Isa>(
         // is as unpredictable as a coin): with one, `last` is `first` and nothing waits.
         let last = (u32::BITS - 1 - hits.leading_zeros()) as usize;
         let (near, far) = if t[last] < t[first] { (last, first) } else { (first, last) };
-        fetch::<I>(nodes, &child(far), visitor);
+        fetch::<I, _>(nodes, &child(far), visitor);
         stack.push_if(child(far), rest != 0);
         return child(near);
     }
@@ -354,7 +374,7 @@ fn nearest_child<I: Isa>(
     let (keys, len) = BoxSet::nearest_first(hits, &t);
     for &key in keys[1..len].iter().rev() {
         let waiting = child(key as usize & (WIDTH - 1));
-        fetch::<I>(nodes, &waiting, visitor);
+        fetch::<I, _>(nodes, &waiting, visitor);
         stack.push(waiting);
     }
     child(keys[0] as usize & (WIDTH - 1))

@@ -3,7 +3,7 @@
 
 use super::super::bvh::{LeafVisitor, PACKET, PacketVisitor, Visit};
 use super::super::real::{R8, Real};
-use super::super::triangle::{PackRay, RayLanes, intersect_pack, intersect_pack_pair, intersect_triangle_rays, lane_hit};
+use super::super::triangle::{PackRay, RayLanes, TrianglePack, intersect_pack, intersect_pack_pair, intersect_triangle_rays, lane_hit};
 use super::{Mesh, MeshHit};
 use crate::simd::{Isa, Lanes};
 
@@ -23,10 +23,22 @@ impl<I: Isa> LeafVisitor<I> for NearestTriangle<'_, I> {
         Visit::Continue
     }
 
+    const LEAF_LINES: usize = PACK_LINES;
+
     #[inline(always)]
-    fn prefetch(&self, first: u32, count: u32) {
-        prefetch_packs::<I>(self.mesh, first, count);
+    fn leaf_data(&self, first: u32) -> *const u8 {
+        pack_data(self.mesh, first)
     }
+}
+
+/// The most cache lines a pack spans from the line it starts in (three with `f32`).
+const PACK_LINES: usize = (64 - align_of::<TrianglePack>() + size_of::<TrianglePack>()).div_ceil(64);
+
+/// Where pack `first` lies, for asking for it from memory (computed without indexing: it is
+/// never read through).
+#[inline(always)]
+fn pack_data(mesh: &Mesh, first: u32) -> *const u8 {
+    mesh.packs.as_ptr().wrapping_add(first as usize).cast()
 }
 
 /// Asks for the cache lines of the packs `first..first + count`.
@@ -108,9 +120,11 @@ impl<I: Isa> LeafVisitor<I> for AnyTriangle<'_, I> {
         Visit::Continue
     }
 
+    const LEAF_LINES: usize = PACK_LINES;
+
     #[inline(always)]
-    fn prefetch(&self, first: u32, count: u32) {
-        prefetch_packs::<I>(self.mesh, first, count);
+    fn leaf_data(&self, first: u32) -> *const u8 {
+        pack_data(self.mesh, first)
     }
 }
 
