@@ -93,7 +93,8 @@ impl<I: Isa, F: FnMut(u32, u32, &mut Real) -> Visit> LeafVisitor<I> for VisitFn<
 pub trait PacketVisitor<I: Isa> {
     fn leaf(&mut self, first: u32, count: u32, rays: u32, t_limit: &mut [Real; PACKET]);
 
-    /// As [`LeafVisitor::prefetch`]: a leaf was put on the stack (a hint that changes nothing).
+    /// Called when a leaf is put on the packet's stack, so that its primitives can be asked for
+    /// from memory while the nearer children are visited (a hint: it must change nothing).
     #[inline(always)]
     fn prefetch(&self, _first: u32, _count: u32) {}
 }
