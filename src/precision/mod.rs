@@ -8,8 +8,8 @@
 //! monomorphic, so `f32` renders are exactly what they were before `f64` existed.
 //!
 //! Precision-free parts (options, ray counting, progress, errors, the film) live outside, so a
-//! render returns the same types whichever precision drew it; [`with_precision!`] picks the
-//! instantiation a case asks for.
+//! render returns the same types whichever precision drew it;
+//! [`with_precision!`](crate::with_precision) picks the instantiation a case asks for.
 
 // Loading the same files as modules of both instantiations is the point, not an accident.
 #![allow(clippy::duplicate_mod)]
