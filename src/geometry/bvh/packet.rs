@@ -199,14 +199,14 @@ pub fn traverse_packet<I: Isa>(
     let mut current = PacketPending { t: 0.0, index: 0, count: 0, rays };
     // The farthest any ray may still reach, for the frustum's test; it changes only at leaves.
     let mut reach = (R8::<I>::load(&t_limit[..]) * R8::<I>::splat(BOX_SLACK)).max_lane();
-    // A node's entered children, in slot order until ordered below; only the first `hit` are
-    // meaningful, so the array is filled once, not for every node.
-    let mut children = [(0u64, 0u32); WIDTH];
+    // Per slot of a node, the nearest entry and the rays of an entered child; only the slots
+    // in `entered_slots` are meaningful, so the arrays are filled once, not for every node.
+    let (mut child_entry, mut entered_rays) = ([0.0; WIDTH], [0u32; WIDTH]);
     loop {
         if current.count == 0 {
             let node = &nodes[current.index as usize];
             let limit = R8::<I>::load(&t_limit[..]) * R8::<I>::splat(BOX_SLACK);
-            let mut hit = 0;
+            let mut entered_slots = 0u32;
             // The node's entry and exit planes, as one ray's traversal computes them, then
             // lane by lane.
             let plane_lanes = lanes.entry_exit(node);
@@ -264,36 +264,41 @@ pub fn traverse_packet<I: Isa>(
                         }
                         nearest
                     };
-                    // The key orders by the entry; its low bits carry the slot.
-                    children[hit] = (sort_key(nearest, slot), entered);
-                    hit += 1;
+                    child_entry[slot] = nearest;
+                    entered_rays[slot] = entered;
+                    entered_slots |= 1 << slot;
                 }
             }
-            if hit > 0 {
-                let pending = |(key, rays): (u64, u32)| {
-                    let slot = key as usize & (WIDTH - 1);
-                    let t = Real::from_bits_key(key);
-                    PacketPending { t, index: node.child[slot], count: node.count[slot] as u32, rays }
+            if entered_slots != 0 {
+                // Ordered by the keys of one ray's traversal (by entry, then slot), and waiting
+                // at the distance the key keeps (rounded down).
+                let key = |slot: usize| sort_key(child_entry[slot], slot);
+                let pending = |slot: usize| PacketPending {
+                    t: Real::from_bits_key(key(slot)),
+                    index: node.child[slot],
+                    count: node.count[slot] as u32,
+                    rays: entered_rays[slot],
                 };
-                if hit <= 2 {
+                let first = entered_slots.trailing_zeros() as usize;
+                let rest = entered_slots & (entered_slots - 1);
+                if rest & rest.wrapping_sub(1) == 0 {
                     // One child or two, the common cases, without a branch on which is nearer
-                    // (a coin toss) or on how many: with one, `last` is the first and nothing
+                    // (a coin toss) or on how many: with one, `last` is `first` and nothing
                     // waits.
-                    let last = hit - 1;
-                    let swap = children[last].0 < children[0].0;
-                    let (near, far) = if swap { (last, 0) } else { (0, last) };
-                    let waiting = pending(children[far]);
+                    let last = (u32::BITS - 1 - entered_slots.leading_zeros()) as usize;
+                    let (near, far) = if key(last) < key(first) { (last, first) } else { (first, last) };
+                    let waiting = pending(far);
                     fetch::<I>(nodes, &waiting, visitor);
-                    stack.push_if(waiting, hit == 2);
-                    current = pending(children[near]);
+                    stack.push_if(waiting, rest != 0);
+                    current = pending(near);
                 } else {
-                    insertion_sort(&mut children[..hit]);
-                    for &child in children[1..hit].iter().rev() {
-                        let waiting = pending(child);
+                    let (keys, len) = BoxSet::nearest_first(entered_slots, &child_entry);
+                    for &ordered in keys[1..len].iter().rev() {
+                        let waiting = pending(BoxSet::lane(ordered));
                         fetch::<I>(nodes, &waiting, visitor);
                         stack.push(waiting);
                     }
-                    current = pending(children[0]);
+                    current = pending(BoxSet::lane(keys[0]));
                 }
                 continue;
             }
@@ -311,20 +316,6 @@ pub fn traverse_packet<I: Isa>(
                 break;
             }
         }
-    }
-}
-
-/// Sorts `children` by key, nearest first (three to eight of them: few enough for insertion).
-#[inline(always)]
-fn insertion_sort(children: &mut [(u64, u32)]) {
-    for next in 1..children.len() {
-        let child = children[next];
-        let mut k = next;
-        while k > 0 && children[k - 1].0 > child.0 {
-            children[k] = children[k - 1];
-            k -= 1;
-        }
-        children[k] = child;
     }
 }
 
