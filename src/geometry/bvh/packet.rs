@@ -320,7 +320,8 @@ pub fn traverse_packet<I: Isa>(
 }
 
 /// A child that waits on the stack is fetched from memory meanwhile: a node here, a leaf's
-/// primitives by the visitor.
+/// primitives by the visitor. A branch, not one ray's select between the two addresses
+/// (`traverse::fetch`): measured with packets, the select was slower (docs/speed.md).
 #[inline(always)]
 fn fetch<I: Isa>(nodes: &[BvhNode], pending: &PacketPending, visitor: &impl PacketVisitor<I>) {
     if pending.count == 0 {

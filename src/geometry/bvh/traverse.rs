@@ -224,7 +224,7 @@ const NODE_LINES: usize = size_of::<BvhNode>().div_ceil(64);
 #[inline(always)]
 pub(super) fn prefetch_node<I: Isa>(nodes: &[BvhNode], index: u32) {
     let node: *const BvhNode = &nodes[index as usize];
-    for line in 0..size_of::<BvhNode>().div_ceil(64) {
+    for line in 0..NODE_LINES {
         I::prefetch(node.cast::<u8>().wrapping_add(64 * line));
     }
 }
