@@ -12,6 +12,24 @@ pub fn join4<I: crate::simd::Isa>(low: R4<I>, high: R4<I>) -> R8<I> {
     I::join_f64(low, high)
 }
 
+/// Lane `a` of `x` in lanes 0–3 and lane `b` in lanes 4–7 (each index taken modulo 8).
+#[inline(always)]
+pub fn lane_pair<I: crate::simd::Isa>(x: R8<I>, [a, b]: [usize; 2]) -> R8<I> {
+    use crate::simd::Lanes;
+    let mut values = [0.0; 8];
+    x.store(&mut values);
+    join4::<I>(R4::<I>::splat(values[a % 8]), R4::<I>::splat(values[b % 8]))
+}
+
+/// Lane `lane` of `x` (taken modulo 8) in each of four lanes.
+#[inline(always)]
+pub fn lane_splat<I: crate::simd::Isa>(x: R8<I>, lane: usize) -> R4<I> {
+    use crate::simd::Lanes;
+    let mut values = [0.0; 8];
+    x.store(&mut values);
+    R4::<I>::splat(values[lane % 8])
+}
+
 /// The triangle test's edge function `a.x·b.y − a.y·b.x` on eight lanes (already `f64`).
 #[inline(always)]
 pub fn edge8<I: crate::simd::Isa>(ax: R8<I>, ay: R8<I>, bx: R8<I>, by: R8<I>) -> R8<I> {

@@ -13,6 +13,18 @@ pub fn join4<I: crate::simd::Isa>(low: R4<I>, high: R4<I>) -> R8<I> {
     I::join(low, high)
 }
 
+/// Lane `a` of `x` in lanes 0–3 and lane `b` in lanes 4–7.
+#[inline(always)]
+pub fn lane_pair<I: crate::simd::Isa>(x: R8<I>, [a, b]: [usize; 2]) -> R8<I> {
+    I::lane_pair(x, a, b)
+}
+
+/// Lane `lane` of `x` in each of four lanes.
+#[inline(always)]
+pub fn lane_splat<I: crate::simd::Isa>(x: R8<I>, lane: usize) -> R4<I> {
+    I::split(I::lane_pair(x, lane, lane)).0
+}
+
 /// The triangle test's edge function `a.x·b.y − a.y·b.x` on eight lanes, in `f64` (exact
 /// products) rounded back, as `geometry::triangle` computes it lane by lane.
 #[inline(always)]

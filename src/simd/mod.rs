@@ -206,6 +206,9 @@ pub trait Isa: Copy + 'static {
     fn join(low: Self::F32x4, high: Self::F32x4) -> Self::F32x8;
     /// [`Isa::join`] of `f64` lanes.
     fn join_f64(low: Self::F64x4, high: Self::F64x4) -> Self::F64x8;
+    /// Lane `a` of `x` in lanes 0–3 and lane `b` in lanes 4–7 (each index taken modulo 8):
+    /// two of eight rays' values side by side, for a test of both against four triangles.
+    fn lane_pair(x: Self::F32x8, a: usize, b: usize) -> Self::F32x8;
     /// Asks for the cache line holding `address` to be loaded, without waiting for it (a hint
     /// that changes no result; nothing on the portable path).
     fn prefetch<T>(address: *const T);

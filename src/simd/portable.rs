@@ -45,6 +45,12 @@ impl Isa for Portable {
     }
 
     #[inline(always)]
+    fn lane_pair(x: Array<f32, 8>, a: usize, b: usize) -> Array<f32, 8> {
+        let (a, b) = (x.0[a % 8], x.0[b % 8]);
+        Array([a, a, a, a, b, b, b, b])
+    }
+
+    #[inline(always)]
     fn prefetch<T>(_: *const T) {}
 
     #[inline(always)]

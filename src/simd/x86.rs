@@ -93,6 +93,16 @@ macro_rules! isa {
             }
 
             #[inline(always)]
+            fn lane_pair(x: F32x8, a: usize, b: usize) -> F32x8 {
+                // One permutation a value; the index vector is built once for all of a pair's
+                // values. The instruction reads only an index's low three bits.
+                unsafe {
+                    let index = _mm256_set_m128i(_mm_set1_epi32(b as i32), _mm_set1_epi32(a as i32));
+                    F32x8(_mm256_permutevar8x32_ps(x.0, index))
+                }
+            }
+
+            #[inline(always)]
             fn prefetch<T>(address: *const T) {
                 // SAFETY: a prefetch never faults, whatever the address.
                 unsafe { _mm_prefetch::<_MM_HINT_T0>(address.cast()) }

@@ -8,8 +8,8 @@ use goldray::geometry::mesh::{Mesh, MeshHit, VertexNormals};
 use goldray::geometry::triangle::{
     RayLanes, TrianglePack, TriangleRay, intersect_pack, intersect_pack_pair, intersect_triangle,
 };
-use goldray::real::{Real, Vec3};
-use goldray::simd::{Isa, Kernel};
+use goldray::real::{R8, Real, Vec3};
+use goldray::simd::{Isa, Kernel, Lanes};
 use proptest::prelude::*;
 
 use super::{Rng, ray_through};
@@ -142,7 +142,7 @@ impl Kernel for PairsAndSingles<'_> {
         for pack in self.packs {
             for a in 0..PACKET {
                 for b in a + 1..PACKET {
-                    let pair = intersect_pack_pair::<I>(pack, &lanes, [a, b], [self.t_max[a], self.t_max[b]]);
+                    let pair = intersect_pack_pair::<I>(pack, &lanes, [a, b], R8::<I>::load(&self.t_max[..]));
                     let (alone_a, alone_b) = (
                         intersect_pack::<I>(pack, &lanes.pack_ray(a), self.t_max[a]),
                         intersect_pack::<I>(pack, &lanes.pack_ray(b), self.t_max[b]),

@@ -196,7 +196,7 @@ impl<I: Isa> NearestTriangles<'_, I> {
     #[inline(always)]
     fn nearest_in_packs_pair(&mut self, first: u32, count: u32, pair: [usize; 2], t_limit: &mut [Real; PACKET]) {
         for pack in &self.mesh.packs[first as usize..(first + count) as usize] {
-            let found = intersect_pack_pair::<I>(pack, &self.rays, pair, [t_limit[pair[0]], t_limit[pair[1]]]);
+            let found = intersect_pack_pair::<I>(pack, &self.rays, pair, R8::<I>::load(&t_limit[..]));
             let mut lanes = found.lanes;
             if lanes == 0 {
                 continue;

@@ -3,7 +3,7 @@
 //! ([`intersect_triangle_rays`], for packets). Lane by lane the operations are the one-ray
 //! test's, so every `t` and barycentric is what that test gives.
 
-use super::super::real::{R4, R8, Real, Vec3, edge4, edge8, gamma, join4};
+use super::super::real::{R4, R8, Real, Vec3, edge4, edge8, gamma, join4, lane_pair, lane_splat};
 use super::super::Ray;
 use super::super::lanes;
 use super::*;
@@ -174,8 +174,6 @@ pub struct RayLanes<I: Isa> {
     /// Each ray's origin, permuted.
     origin: [R8<I>; 3],
     shear: [R8<I>; 3],
-    /// The lanes of `origin` and then `shear` as values, for [`RayLanes::pack_ray`].
-    values: [[Real; 8]; 6],
 }
 
 impl<I: Isa> RayLanes<I> {
@@ -209,30 +207,20 @@ impl<I: Isa> RayLanes<I> {
         let (dx, dy, dz) = (d[axes[0]], d[axes[1]], d[axes[2]]);
         let origin = [o[axes[0]], o[axes[1]], o[axes[2]]];
         let shear = [-dx / dz, -dy / dz, R8::<I>::splat(1.0) / dz];
-        let mut values = [[0.0; 8]; 6];
-        for (values, lanes) in values.iter_mut().zip(origin.iter().chain(&shear)) {
-            lanes.store(values);
-        }
-        Some(RayLanes { axes, origin, shear, values })
+        Some(RayLanes { axes, origin, shear })
     }
 
     /// Lane `lane`'s ray as [`PackRay::new`] makes it, for testing a pack's four triangles
     /// against that ray alone (cheaper than four tests of all eight lanes when few rays are left).
     #[inline(always)]
     pub fn pack_ray(&self, lane: usize) -> PackRay<I> {
-        let v = &self.values;
+        let (o, s) = (&self.origin, &self.shear);
         PackRay {
             axes: self.axes,
-            origin: [R4::<I>::splat(v[0][lane]), R4::<I>::splat(v[1][lane]), R4::<I>::splat(v[2][lane])],
-            shear: [R4::<I>::splat(v[3][lane]), R4::<I>::splat(v[4][lane]), R4::<I>::splat(v[5][lane])],
+            origin: [lane_splat::<I>(o[0], lane), lane_splat::<I>(o[1], lane), lane_splat::<I>(o[2], lane)],
+            shear: [lane_splat::<I>(s[0], lane), lane_splat::<I>(s[1], lane), lane_splat::<I>(s[2], lane)],
         }
     }
-}
-
-/// Value `values[a]` in lanes 0–3 and `values[b]` in lanes 4–7.
-#[inline(always)]
-fn lane_pair<I: Isa>(values: &[Real; 8], [a, b]: [usize; 2]) -> R8<I> {
-    join4::<I>(R4::<I>::splat(values[a]), R4::<I>::splat(values[b]))
 }
 
 /// Vertex `v` of each triangle of `pack` twice over (lanes 0–3 and 4–7), relative to the
@@ -253,17 +241,17 @@ fn twice<I: Isa>(values: &[Real; 4]) -> R8<I> {
     join4::<I>(lanes, lanes)
 }
 
-/// [`intersect_pack`] of two rays of `rays` at once, lanes `pair[0]` and `pair[1]` with limits
-/// `t_max`: lanes 0–3 are the first ray against the pack's four triangles, lanes 4–7 the second.
+/// [`intersect_pack`] of two rays of `rays` at once, lanes `pair[0]` and `pair[1]` with the
+/// limits in those lanes of `t_max`: lanes 0–3 are the first ray against the pack's four triangles, lanes 4–7 the second.
 /// Lane by lane the operations of [`intersect_pack`], so each lane's hit is bit for bit that
 /// test's; one test of eight lanes where two of four would repeat the work done in `f32`.
 ///
 /// A kernel: compile it only inside one (see `crate::simd`).
 #[inline(always)]
-pub fn intersect_pack_pair<I: Isa>(pack: &TrianglePack, rays: &RayLanes<I>, pair: [usize; 2], t_max: [Real; 2]) -> RayHits<I> {
-    let v = &rays.values;
-    let origin = [lane_pair::<I>(&v[0], pair), lane_pair::<I>(&v[1], pair), lane_pair::<I>(&v[2], pair)];
-    let shear = [lane_pair::<I>(&v[3], pair), lane_pair::<I>(&v[4], pair), lane_pair::<I>(&v[5], pair)];
+pub fn intersect_pack_pair<I: Isa>(pack: &TrianglePack, rays: &RayLanes<I>, pair: [usize; 2], t_max: R8<I>) -> RayHits<I> {
+    let (o, s) = (&rays.origin, &rays.shear);
+    let origin = [lane_pair::<I>(o[0], pair), lane_pair::<I>(o[1], pair), lane_pair::<I>(o[2], pair)];
+    let shear = [lane_pair::<I>(s[0], pair), lane_pair::<I>(s[1], pair), lane_pair::<I>(s[2], pair)];
     let p0 = pair_vertex::<I>(pack, rays.axes, &origin, &shear, 0);
     let p1 = pair_vertex::<I>(pack, rays.axes, &origin, &shear, 1);
     let p2 = pair_vertex::<I>(pack, rays.axes, &origin, &shear, 2);
@@ -272,8 +260,7 @@ pub fn intersect_pack_pair<I: Isa>(pack: &TrianglePack, rays: &RayLanes<I>, pair
         edge8::<I>(p2[0], p2[1], p0[0], p0[1]),
         edge8::<I>(p0[0], p0[1], p1[0], p1[1]),
     );
-    let t_max = join4::<I>(R4::<I>::splat(t_max[0]), R4::<I>::splat(t_max[1]));
-    finish_test([p0, p1, p2], [e0, e1, e2], shear[2], t_max, pack.live | pack.live << 4)
+    finish_test([p0, p1, p2], [e0, e1, e2], shear[2], lane_pair::<I>(t_max, pair), pack.live | pack.live << 4)
 }
 
 /// Vertex `v` of triangle `triangle` of `pack`, relative to each ray's origin, permuted and
