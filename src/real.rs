@@ -4,7 +4,7 @@
 //! types are whatever the enclosing instantiation names, and everything here is written against
 //! those names only. Film storage stays `f32` because that is what the EXR and PNG outputs hold.
 
-pub use super::{Mat3, Mat4, R4, R8, Real, Vec2, Vec3, edge4, edge8, join4, lane_pair, lane_splat};
+pub use super::{Mat3, Mat4, R4, R8, Real, Vec2, Vec3, edge4, edge8, join4, lane_pair, lane_splat, transpose_rays};
 
 /// Linear RGB radiance, in the same precision as shading.
 pub type Color = Vec3;

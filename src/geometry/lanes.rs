@@ -11,7 +11,7 @@ use std::ops::{Add, Mul, Neg, Sub};
 
 use super::aabb::Aabb;
 use super::ray::{Ray, SurfaceHit};
-use super::real::{R8, Real, Vec3, gamma};
+use super::real::{R8, Real, Vec3, gamma, transpose_rays};
 use crate::simd::{Isa, Lanes, MaskOps};
 
 /// Rays traced together.
@@ -208,6 +208,12 @@ impl<I: Isa> RayLanes<I> {
     /// If `rays` is empty.
     #[inline(always)]
     pub fn gather(rays: &[Ray]) -> Self {
+        // A full packet of `f32` rays is shuffled into lanes from its 48 values at once.
+        if let Ok(values) = <&[Real; 6 * LANES]>::try_from(bytemuck::cast_slice::<Ray, Real>(rays))
+            && let Some([ox, oy, oz, dx, dy, dz]) = transpose_rays::<I>(values)
+        {
+            return RayLanes { origin: V3 { x: ox, y: oy, z: oz }, direction: V3 { x: dx, y: dy, z: dz } };
+        }
         let mut axes = [[[0.0; LANES]; 3]; 2];
         for lane in 0..LANES {
             let ray = &rays[lane.min(rays.len() - 1)];

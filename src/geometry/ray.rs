@@ -3,7 +3,8 @@ use super::real::{Real, Vec3};
 /// A ray `origin + t·direction`. The direction is not required to be unit length: instancing
 /// keeps the world-space parameter `t` by transforming the direction without renormalising it,
 /// and shadow rays to point lights use the full vector to the light so that `t = 1` is the light.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+#[repr(C)]
 pub struct Ray {
     pub origin: Vec3,
     pub direction: Vec3,

@@ -12,6 +12,12 @@ pub fn join4<I: crate::simd::Isa>(low: R4<I>, high: R4<I>) -> R8<I> {
     I::join_f64(low, high)
 }
 
+/// No shuffle of `f64` rays into lanes: they are put in value by value.
+#[inline(always)]
+pub fn transpose_rays<I: crate::simd::Isa>(_values: &[f64; 48]) -> Option<[R8<I>; 6]> {
+    None
+}
+
 /// Lane `a` of `x` in lanes 0–3 and lane `b` in lanes 4–7 (each index taken modulo 8).
 #[inline(always)]
 pub fn lane_pair<I: crate::simd::Isa>(x: R8<I>, [a, b]: [usize; 2]) -> R8<I> {

@@ -13,6 +13,13 @@ pub fn join4<I: crate::simd::Isa>(low: R4<I>, high: R4<I>) -> R8<I> {
     I::join(low, high)
 }
 
+/// Eight rays' origins and directions (`values[6k..6k + 6]` the `k`-th ray's) into lanes,
+/// component by component: `[ox, oy, oz, dx, dy, dz]`.
+#[inline(always)]
+pub fn transpose_rays<I: crate::simd::Isa>(values: &[f32; 48]) -> Option<[R8<I>; 6]> {
+    Some(I::transpose_8x6(values))
+}
+
 /// Lane `a` of `x` in lanes 0–3 and lane `b` in lanes 4–7.
 #[inline(always)]
 pub fn lane_pair<I: crate::simd::Isa>(x: R8<I>, [a, b]: [usize; 2]) -> R8<I> {

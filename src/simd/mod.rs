@@ -206,6 +206,9 @@ pub trait Isa: Copy + 'static {
     fn join(low: Self::F32x4, high: Self::F32x4) -> Self::F32x8;
     /// [`Isa::join`] of `f64` lanes.
     fn join_f64(low: Self::F64x4, high: Self::F64x4) -> Self::F64x8;
+    /// Eight records of six values (`values[6k..6k + 6]` the `k`-th) field by field: lane `k`
+    /// of the `j`-th result is `values[6k + j]` (eight rays' origins and directions into lanes).
+    fn transpose_8x6(values: &[f32; 48]) -> [Self::F32x8; 6];
     /// Lane `a` of `x` in lanes 0–3 and lane `b` in lanes 4–7 (each index taken modulo 8):
     /// two of eight rays' values side by side, for a test of both against four triangles.
     fn lane_pair(x: Self::F32x8, a: usize, b: usize) -> Self::F32x8;
@@ -394,6 +397,64 @@ mod tests {
             ];
             for result in results.into_iter().flatten() {
                 assert_eq!(format!("{result:?}"), format!("{portable:?}"));
+            }
+        }
+    }
+
+    /// 48 distinct values: NaNs with distinct payloads, signed zeros, negative and fractional
+    /// numbers.
+    fn movement_input() -> [f32; 48] {
+        std::array::from_fn(|i| match i % 5 {
+            0 => f32::from_bits(0x7fc0_0000 | i as u32),
+            1 => -(i as f32),
+            2 if i % 2 == 0 => 0.0,
+            2 => -0.0,
+            _ => 1.0 + i as f32 / 64.0,
+        })
+    }
+
+    /// `transpose_8x6` of 48 distinct values (NaNs with distinct payloads, signed zeros among
+    /// them), and `lane_pair` of every pair of lanes (and out-of-range indices), stored back.
+    struct Movements;
+
+    impl Kernel for Movements {
+        type Output = (Vec<[u32; 8]>, Vec<[u32; 8]>);
+        fn run<I: Isa>(self) -> Self::Output {
+            let values = movement_input();
+            let bits = |lanes: I::F32x8| {
+                let mut out = [0.0; 8];
+                lanes.store(&mut out);
+                out.map(f32::to_bits)
+            };
+            let fields = I::transpose_8x6(&values).map(bits).to_vec();
+            let source = I::F32x8::load(&values[8..16]);
+            let pairs = (0..10)
+                .flat_map(|a| (0..10).map(move |b| (a, b)))
+                .map(|(a, b)| bits(I::lane_pair(source, a, b)))
+                .collect();
+            (fields, pairs)
+        }
+    }
+
+    #[test]
+    fn lanes_are_moved_to_where_they_belong_on_every_path() {
+        for path in available() {
+            let (fields, pairs) = dispatch_on(path, Movements).unwrap();
+            let input = movement_input();
+            for (field, lanes) in fields.iter().enumerate() {
+                for (k, &lane) in lanes.iter().enumerate() {
+                    assert_eq!(
+                        lane,
+                        input[6 * k + field].to_bits(),
+                        "{path:?}: field {field} of ray {k}"
+                    );
+                }
+            }
+            for (n, lanes) in pairs.iter().enumerate() {
+                let (a, b) = (n / 10, n % 10);
+                let expected: [u32; 8] =
+                    std::array::from_fn(|k| input[8 + if k < 4 { a % 8 } else { b % 8 }].to_bits());
+                assert_eq!(*lanes, expected, "{path:?}: lane_pair({a}, {b})");
             }
         }
     }

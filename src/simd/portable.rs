@@ -45,6 +45,11 @@ impl Isa for Portable {
     }
 
     #[inline(always)]
+    fn transpose_8x6(values: &[f32; 48]) -> [Array<f32, 8>; 6] {
+        std::array::from_fn(|field| Array(std::array::from_fn(|k| values[6 * k + field])))
+    }
+
+    #[inline(always)]
     fn lane_pair(x: Array<f32, 8>, a: usize, b: usize) -> Array<f32, 8> {
         let (a, b) = (x.0[a % 8], x.0[b % 8]);
         Array([a, a, a, a, b, b, b, b])
