@@ -242,7 +242,8 @@ fn twice<I: Isa>(values: &[Real; 4]) -> R8<I> {
 }
 
 /// [`intersect_pack`] of two rays of `rays` at once, lanes `pair[0]` and `pair[1]` with the
-/// limits in those lanes of `t_max`: lanes 0–3 are the first ray against the pack's four triangles, lanes 4–7 the second.
+/// limits in those lanes of `t_max`: lanes 0–3 are the first ray against the pack's four
+/// triangles, lanes 4–7 the second.
 /// Lane by lane the operations of [`intersect_pack`], so each lane's hit is bit for bit that
 /// test's; one test of eight lanes where two of four would repeat the work done in `f32`.
 ///
