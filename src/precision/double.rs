@@ -21,19 +21,13 @@ pub fn transpose_rays<I: crate::simd::Isa>(_values: &[f64; 48]) -> Option<[R8<I>
 /// Lane `a` of `x` in lanes 0–3 and lane `b` in lanes 4–7 (each index taken modulo 8).
 #[inline(always)]
 pub fn lane_pair<I: crate::simd::Isa>(x: R8<I>, [a, b]: [usize; 2]) -> R8<I> {
-    use crate::simd::Lanes;
-    let mut values = [0.0; 8];
-    x.store(&mut values);
-    join4::<I>(R4::<I>::splat(values[a % 8]), R4::<I>::splat(values[b % 8]))
+    I::lane_pair_f64(x, a, b)
 }
 
 /// Lane `lane` of `x` (taken modulo 8) in each of four lanes.
 #[inline(always)]
 pub fn lane_splat<I: crate::simd::Isa>(x: R8<I>, lane: usize) -> R4<I> {
-    use crate::simd::Lanes;
-    let mut values = [0.0; 8];
-    x.store(&mut values);
-    R4::<I>::splat(values[lane % 8])
+    I::lane_splat_f64(x, lane)
 }
 
 /// The triangle test's edge function `a.x·b.y − a.y·b.x` on eight lanes (already `f64`).

@@ -212,6 +212,10 @@ pub trait Isa: Copy + 'static {
     /// Lane `a` of `x` in lanes 0–3 and lane `b` in lanes 4–7 (each index taken modulo 8):
     /// two of eight rays' values side by side, for a test of both against four triangles.
     fn lane_pair(x: Self::F32x8, a: usize, b: usize) -> Self::F32x8;
+    /// [`Isa::lane_pair`] of `f64` lanes.
+    fn lane_pair_f64(x: Self::F64x8, a: usize, b: usize) -> Self::F64x8;
+    /// Lane `lane` of `x` (taken modulo 8) in each of four lanes.
+    fn lane_splat_f64(x: Self::F64x8, lane: usize) -> Self::F64x4;
     /// Asks for the cache line holding `address` to be loaded, without waiting for it (a hint
     /// that changes no result; nothing on the portable path).
     fn prefetch<T>(address: *const T);
@@ -414,11 +418,12 @@ mod tests {
     }
 
     /// `transpose_8x6` of 48 distinct values (NaNs with distinct payloads, signed zeros among
-    /// them), and `lane_pair` of every pair of lanes (and out-of-range indices), stored back.
+    /// them), and `lane_pair`, `lane_pair_f64` and `lane_splat_f64` of every lane or pair of
+    /// lanes (and out-of-range indices), stored back.
     struct Movements;
 
     impl Kernel for Movements {
-        type Output = (Vec<[u32; 8]>, Vec<[u32; 8]>);
+        type Output = (Vec<[u32; 8]>, Vec<[u32; 8]>, Vec<[u64; 8]>, Vec<[u64; 4]>);
         fn run<I: Isa>(self) -> Self::Output {
             let values = movement_input();
             let bits = |lanes: I::F32x8| {
@@ -432,14 +437,30 @@ mod tests {
                 .flat_map(|a| (0..10).map(move |b| (a, b)))
                 .map(|(a, b)| bits(I::lane_pair(source, a, b)))
                 .collect();
-            (fields, pairs)
+            let wide = I::F64x8::load(&values[8..16].iter().map(|&v| f64::from(v)).collect::<Vec<_>>());
+            let wide_pairs = (0..10)
+                .flat_map(|a| (0..10).map(move |b| (a, b)))
+                .map(|(a, b)| {
+                    let mut out = [0.0; 8];
+                    I::lane_pair_f64(wide, a, b).store(&mut out);
+                    out.map(f64::to_bits)
+                })
+                .collect();
+            let wide_splats = (0..10)
+                .map(|lane| {
+                    let mut out = [0.0; 4];
+                    I::lane_splat_f64(wide, lane).store(&mut out);
+                    out.map(f64::to_bits)
+                })
+                .collect();
+            (fields, pairs, wide_pairs, wide_splats)
         }
     }
 
     #[test]
     fn lanes_are_moved_to_where_they_belong_on_every_path() {
         for path in available() {
-            let (fields, pairs) = dispatch_on(path, Movements).unwrap();
+            let (fields, pairs, wide_pairs, wide_splats) = dispatch_on(path, Movements).unwrap();
             let input = movement_input();
             for (field, lanes) in fields.iter().enumerate() {
                 for (k, &lane) in lanes.iter().enumerate() {
@@ -455,6 +476,15 @@ mod tests {
                 let expected: [u32; 8] =
                     std::array::from_fn(|k| input[8 + if k < 4 { a % 8 } else { b % 8 }].to_bits());
                 assert_eq!(*lanes, expected, "{path:?}: lane_pair({a}, {b})");
+            }
+            let wide = |lane: usize| f64::from(input[8 + lane % 8]).to_bits();
+            for (n, lanes) in wide_pairs.iter().enumerate() {
+                let (a, b) = (n / 10, n % 10);
+                let expected: [u64; 8] = std::array::from_fn(|k| wide(if k < 4 { a } else { b }));
+                assert_eq!(*lanes, expected, "{path:?}: lane_pair_f64({a}, {b})");
+            }
+            for (lane, lanes) in wide_splats.iter().enumerate() {
+                assert_eq!(*lanes, [wide(lane); 4], "{path:?}: lane_splat_f64({lane})");
             }
         }
     }

@@ -56,6 +56,17 @@ impl Isa for Portable {
     }
 
     #[inline(always)]
+    fn lane_pair_f64(x: Array<f64, 8>, a: usize, b: usize) -> Array<f64, 8> {
+        let (a, b) = (x.0[a % 8], x.0[b % 8]);
+        Array([a, a, a, a, b, b, b, b])
+    }
+
+    #[inline(always)]
+    fn lane_splat_f64(x: Array<f64, 8>, lane: usize) -> Array<f64, 4> {
+        Array([x.0[lane % 8]; 4])
+    }
+
+    #[inline(always)]
     fn prefetch<T>(_: *const T) {}
 
     #[inline(always)]

@@ -114,6 +114,16 @@ macro_rules! isa {
             }
 
             #[inline(always)]
+            fn lane_pair_f64(x: F64x8, a: usize, b: usize) -> F64x8 {
+                unsafe { F64x8([F64x4(f64_lane(x, a)), F64x4(f64_lane(x, b))]) }
+            }
+
+            #[inline(always)]
+            fn lane_splat_f64(x: F64x8, lane: usize) -> F64x4 {
+                unsafe { F64x4(f64_lane(x, lane)) }
+            }
+
+            #[inline(always)]
             fn prefetch<T>(address: *const T) {
                 // SAFETY: a prefetch never faults, whatever the address.
                 unsafe { _mm_prefetch::<_MM_HINT_T0>(address.cast()) }
@@ -172,6 +182,22 @@ unsafe fn transpose_8x4(values: &[f32; 48], first: usize) -> [__m256; 4] {
             _mm256_shuffle_ps::<0x44>(high01, high23),
             _mm256_shuffle_ps::<0xee>(high01, high23),
         ]
+    }
+}
+
+/// Lane `lane` (taken modulo 8) of `x` in each of four lanes: the lane's two 32-bit halves
+/// permuted out of both halves of `x`, then the half that holds it chosen by a blend (no store
+/// and reload, no branch on the lane).
+#[inline(always)]
+unsafe fn f64_lane(x: F64x8, lane: usize) -> __m256d {
+    unsafe {
+        let word = 2 * (lane % 4) as i64;
+        let index = _mm256_set1_epi64x(((word + 1) << 32) | word);
+        let [low, high] = x.0;
+        let from_low = _mm256_permutevar8x32_ps(_mm256_castpd_ps(low.0), index);
+        let from_high = _mm256_permutevar8x32_ps(_mm256_castpd_ps(high.0), index);
+        let take_high = _mm256_castsi256_ps(_mm256_set1_epi32(-((lane / 4 % 2) as i32)));
+        _mm256_castps_pd(_mm256_blendv_ps(from_low, from_high, take_high))
     }
 }
 
