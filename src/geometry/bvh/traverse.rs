@@ -196,13 +196,13 @@ impl<'a, T: Copy> Stack<'a, T> {
 /// to fetch has its leaves passed over (its null address is not asked for).
 #[inline(always)]
 fn fetch<I: Isa, V: LeafVisitor<I>>(nodes: &[BvhNode], pending: &Pending, visitor: &V) {
-    let node = nodes.as_ptr().wrapping_add(pending.index as usize).cast::<u8>();
     if V::LEAF_LINES == 0 {
         if pending.count == 0 {
-            prefetch_lines::<I>(node, NODE_LINES);
+            prefetch_node::<I>(nodes, pending.index);
         }
         return;
     }
+    let node = node_data(nodes, pending.index);
     let leaf = visitor.leaf_data(pending.index);
     let start = if pending.count == 0 { node } else { leaf };
     prefetch_lines::<I>(start, NODE_LINES.max(V::LEAF_LINES));
@@ -220,13 +220,17 @@ fn prefetch_lines<I: Isa>(start: *const u8, lines: usize) {
 /// The cache lines of a node.
 const NODE_LINES: usize = size_of::<BvhNode>().div_ceil(64);
 
+/// Where node `index` lies, for asking for it from memory (computed without indexing: it is
+/// never read through).
+#[inline(always)]
+fn node_data(nodes: &[BvhNode], index: u32) -> *const u8 {
+    nodes.as_ptr().wrapping_add(index as usize).cast()
+}
+
 /// Asks for the cache lines of node `index`.
 #[inline(always)]
 pub(super) fn prefetch_node<I: Isa>(nodes: &[BvhNode], index: u32) {
-    let node: *const BvhNode = &nodes[index as usize];
-    for line in 0..NODE_LINES {
-        I::prefetch(node.cast::<u8>().wrapping_add(64 * line));
-    }
+    prefetch_lines::<I>(node_data(nodes, index), NODE_LINES);
 }
 
 /// Depth-first traversal with an explicit stack, nearest child first: each node's eight boxes
