@@ -41,7 +41,9 @@ fn pack_data(mesh: &Mesh, first: u32) -> *const u8 {
     mesh.packs.as_ptr().wrapping_add(first as usize).cast()
 }
 
-/// Asks for the cache lines of the packs `first..first + count`.
+/// Asks for the cache lines of the packs `first..first + count`. A loop over the leaf's span,
+/// not one ray's [`pack_data`] and [`PACK_LINES`]: with packets that form measured slower, for
+/// fewer instructions (docs/speed.md).
 #[inline(always)]
 fn prefetch_packs<I: Isa>(mesh: &Mesh, first: u32, count: u32) {
     let packs = &mesh.packs[first as usize..(first + count) as usize];
