@@ -18,7 +18,7 @@ use rayon::prelude::*;
 
 use super::Ray;
 use super::aabb::Aabb;
-use super::real::{MACHINE_EPSILON, Real, gamma};
+use super::real::{MACHINE_EPSILON, R8, Real, gamma};
 use crate::simd::{Isa, Kernel, dispatch};
 
 pub use box_set::BoxSet;
@@ -88,10 +88,14 @@ impl<I: Isa, F: FnMut(u32, u32, &mut Real) -> Visit> LeafVisitor<I> for VisitFn<
 }
 
 /// What a packet traversal ([`traverse_packet`]) does at each leaf: `leaf(first, count, rays,
-/// t_limit)` for the rays (a bit per lane) that reached it. As for [`LeafVisitor`], `leaf` is
-/// `#[inline(always)]`.
+/// t_limit)` for the rays (a bit per lane) that reached it, with each ray's limit in its lane.
+/// As for [`LeafVisitor`], `leaf` is `#[inline(always)]`.
+///
+/// The limits stay in lanes from leaf to leaf: the traversal reads all eight at once at every
+/// node, and eight read back from memory just after one of them was written there wait for that
+/// write to reach the cache (a wide load cannot take a narrow store's value on its way).
 pub trait PacketVisitor<I: Isa> {
-    fn leaf(&mut self, first: u32, count: u32, rays: u32, t_limit: &mut [Real; PACKET]);
+    fn leaf(&mut self, first: u32, count: u32, rays: u32, t_limit: &mut R8<I>);
 
     /// Called when a leaf is put on the packet's stack, so that its primitives can be asked for
     /// from memory while the nearer children are visited (a hint: it must change nothing).

@@ -194,8 +194,7 @@ impl Mesh {
             return self.closest_interleaved::<I>(rays, t_max);
         };
         let mut nearest = NearestTriangles { mesh: self, rays: triangle_rays, closest: [None; PACKET] };
-        let mut t_limit = *t_max;
-        traverse_packet::<I>(self.bvh.nodes(), &slab, (1u32 << rays.len()) - 1, &mut t_limit, &mut nearest);
+        traverse_packet::<I>(self.bvh.nodes(), &slab, (1u32 << rays.len()) - 1, t_max, &mut nearest);
         nearest.closest
     }
 

@@ -269,6 +269,9 @@ pub trait Lanes:
     fn eq(self, other: Self) -> Self::Mask;
     /// Lanes that are NaN.
     fn is_nan(self) -> Self::Mask;
+    /// The mask whose lane `i` is set when bit `i` of `bits` is (bits past the last lane are
+    /// ignored): lanes chosen by number, as [`MaskOps::bits`] names them.
+    fn mask(bits: u32) -> Self::Mask;
     /// `mask ? if_true : if_false` per lane.
     fn select(mask: Self::Mask, if_true: Self, if_false: Self) -> Self;
     /// Each lane's bit pattern, read as an integer, plus one where `increment` is set and minus
@@ -383,6 +386,52 @@ mod tests {
                 1.0e-40f32.to_bits() as u64,
                 "{path:?}: lanes in order"
             );
+        }
+    }
+
+    /// Each lane type's `mask` of every lane pattern (and of bits past the last lane), read
+    /// back with `bits` and through `select`.
+    struct MasksByNumber;
+
+    impl Kernel for MasksByNumber {
+        type Output = Vec<[u32; 6]>;
+        fn run<I: Isa>(self) -> Self::Output {
+            let pick = |selected: I::F32x8| {
+                let mut lanes = [0.0; 8];
+                selected.store(&mut lanes);
+                lanes
+                    .iter()
+                    .enumerate()
+                    .map(|(lane, &x)| ((x == 1.0) as u32) << lane)
+                    .sum::<u32>()
+            };
+            (0..512u32)
+                .map(|bits| {
+                    let chosen = I::F32x8::select(I::F32x8::mask(bits), I::F32x8::splat(1.0), I::F32x8::splat(0.0));
+                    [
+                        I::F32x4::mask(bits).bits(),
+                        I::F32x8::mask(bits).bits(),
+                        I::F64x4::mask(bits).bits(),
+                        I::F64x8::mask(bits).bits(),
+                        pick(chosen),
+                        bits,
+                    ]
+                })
+                .collect()
+        }
+    }
+
+    #[test]
+    fn lanes_chosen_by_number_are_those_lanes_on_every_path() {
+        for path in available() {
+            for [f4, f8, d4, d8, selected, bits] in dispatch_on(path, MasksByNumber).unwrap() {
+                assert_eq!([f4, d4], [bits & 0xf; 2], "{path:?}: four lanes of {bits:#b}");
+                assert_eq!(
+                    [f8, d8, selected],
+                    [bits & 0xff; 3],
+                    "{path:?}: eight lanes of {bits:#b}"
+                );
+            }
         }
     }
 

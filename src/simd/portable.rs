@@ -266,6 +266,10 @@ macro_rules! array_lanes {
                 self.compare(self, |a, _| a.is_nan())
             }
             #[inline(always)]
+            fn mask(bits: u32) -> Bits {
+                Bits(bits & ((1 << $n) - 1))
+            }
+            #[inline(always)]
             fn select(mask: Bits, if_true: Self, if_false: Self) -> Self {
                 let (t, f) = (if_true.0, if_false.0);
                 Array([$(if mask.0 & (1 << $lane) != 0 { t[$lane] } else { f[$lane] }),*])

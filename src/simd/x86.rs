@@ -239,7 +239,8 @@ macro_rules! register_lanes {
         xor: $xor:ident, blend: $blend:ident, movemask: $movemask:ident,
         cmp: |$a:ident, $b:ident, $pred:ident| $cmp:expr,
         bits: $to_bits:ident, from_bits: $from_bits:ident, int_add: $int_add:ident, int_sub: $int_sub:ident,
-        min_lane: |$min_v:ident| $min_lane:expr, max_lane: |$max_v:ident| $max_lane:expr
+        min_lane: |$min_v:ident| $min_lane:expr, max_lane: |$max_v:ident| $max_lane:expr,
+        mask: |$mask_bits:ident| $mask_expr:expr
     ) => {
         #[derive(Clone, Copy, Debug)]
         pub struct $name($reg);
@@ -389,6 +390,10 @@ macro_rules! register_lanes {
                 self.compare::<_CMP_UNORD_Q>(self)
             }
             #[inline(always)]
+            fn mask($mask_bits: u32) -> $mask {
+                $mask(unsafe { $mask_expr })
+            }
+            #[inline(always)]
             fn select(mask: $mask, if_true: Self, if_false: Self) -> Self {
                 $name(unsafe { $blend(if_false.0, if_true.0, mask.0) })
             }
@@ -412,7 +417,11 @@ register_lanes!(
     xor: _mm_xor_ps, blend: _mm_blendv_ps, movemask: _mm_movemask_ps,
     cmp: |a, b, P| _mm_cmp_ps::<P>(a, b),
     bits: _mm_castps_si128, from_bits: _mm_castsi128_ps, int_add: _mm_add_epi32, int_sub: _mm_sub_epi32,
-    min_lane: |v| fold4_ps(v, _mm_min_ps, _mm_min_ss), max_lane: |v| fold4_ps(v, _mm_max_ps, _mm_max_ss)
+    min_lane: |v| fold4_ps(v, _mm_min_ps, _mm_min_ss), max_lane: |v| fold4_ps(v, _mm_max_ps, _mm_max_ss),
+    mask: |bits| {
+        let lane_bits = _mm_setr_epi32(1, 2, 4, 8);
+        _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(_mm_set1_epi32(bits as i32), lane_bits), lane_bits))
+    }
 );
 
 register_lanes!(
@@ -425,7 +434,11 @@ register_lanes!(
     cmp: |a, b, P| _mm256_cmp_ps::<P>(a, b),
     bits: _mm256_castps_si256, from_bits: _mm256_castsi256_ps, int_add: _mm256_add_epi32, int_sub: _mm256_sub_epi32,
     min_lane: |v| fold4_ps(_mm_min_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps::<1>(v)), _mm_min_ps, _mm_min_ss),
-    max_lane: |v| fold4_ps(_mm_max_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps::<1>(v)), _mm_max_ps, _mm_max_ss)
+    max_lane: |v| fold4_ps(_mm_max_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps::<1>(v)), _mm_max_ps, _mm_max_ss),
+    mask: |bits| {
+        let lane_bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+        _mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(bits as i32), lane_bits), lane_bits))
+    }
 );
 
 register_lanes!(
@@ -436,7 +449,11 @@ register_lanes!(
     xor: _mm256_xor_pd, blend: _mm256_blendv_pd, movemask: _mm256_movemask_pd,
     cmp: |a, b, P| _mm256_cmp_pd::<P>(a, b),
     bits: _mm256_castpd_si256, from_bits: _mm256_castsi256_pd, int_add: _mm256_add_epi64, int_sub: _mm256_sub_epi64,
-    min_lane: |v| fold4_pd(v, _mm_min_pd, _mm_min_sd), max_lane: |v| fold4_pd(v, _mm_max_pd, _mm_max_sd)
+    min_lane: |v| fold4_pd(v, _mm_min_pd, _mm_min_sd), max_lane: |v| fold4_pd(v, _mm_max_pd, _mm_max_sd),
+    mask: |bits| {
+        let lane_bits = _mm256_setr_epi64x(1, 2, 4, 8);
+        _mm256_castsi256_pd(_mm256_cmpeq_epi64(_mm256_and_si256(_mm256_set1_epi64x(bits as i64), lane_bits), lane_bits))
+    }
 );
 
 /// Eight `f64` lanes as two halves of four.
@@ -566,6 +583,10 @@ impl Lanes for F64x8 {
     #[inline(always)]
     fn is_nan(self) -> M64x8 {
         M64x8([self.0[0].is_nan(), self.0[1].is_nan()])
+    }
+    #[inline(always)]
+    fn mask(bits: u32) -> M64x8 {
+        M64x8([F64x4::mask(bits), F64x4::mask(bits >> 4)])
     }
     #[inline(always)]
     fn select(mask: M64x8, if_true: Self, if_false: Self) -> Self {

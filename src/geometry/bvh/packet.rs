@@ -177,8 +177,9 @@ struct PacketPending {
 /// own `t_limit`). Children are visited nearest first (by the nearest ray's entry, or the packet's
 /// frustum's bound on it). Boxes that no ray of the packet can enter by the frustum's test are
 /// not tested ray by ray; children waiting are fetched from memory meanwhile. `visit(first,
-/// count, rays, t_limit)` is called for each leaf with the rays (bits) that reached it; it may
-/// shrink the rays' entries of `t_limit`, which prunes, ray by ray, every box entered beyond.
+/// count, rays, t_limit)` is called for each leaf with the rays (bits) that reached it and their
+/// limits in lanes, starting from `t_max`; it may shrink the rays' limits, which prunes, ray by
+/// ray, every box entered beyond.
 ///
 /// A kernel: compile it only inside one (see `crate::simd`).
 // The slab test's loop over the axes indexes the planes and four of the packet's arrays.
@@ -188,7 +189,7 @@ pub fn traverse_packet<I: Isa>(
     nodes: &[BvhNode],
     lanes: &PacketLanes<I>,
     rays: u32,
-    t_limit: &mut [Real; PACKET],
+    t_max: &[Real; PACKET],
     visitor: &mut impl PacketVisitor<I>,
 ) {
     if nodes.is_empty() || rays == 0 {
@@ -197,15 +198,16 @@ pub fn traverse_packet<I: Isa>(
     let mut space = StackSpace::<PacketPending>::new();
     let mut stack = space.stack(nodes);
     let mut current = PacketPending { t: 0.0, index: 0, count: 0, rays };
+    let mut t_limit = R8::<I>::load(&t_max[..]);
     // The farthest any ray may still reach, for the frustum's test; it changes only at leaves.
-    let mut reach = (R8::<I>::load(&t_limit[..]) * R8::<I>::splat(BOX_SLACK)).max_lane();
+    let mut reach = (t_limit * R8::<I>::splat(BOX_SLACK)).max_lane();
     // Per slot of a node, the nearest entry and the rays of an entered child; only the slots
     // in `entered_slots` are meaningful, so the arrays are filled once, not for every node.
     let (mut child_entry, mut entered_rays) = ([0.0; WIDTH], [0u32; WIDTH]);
     loop {
         if current.count == 0 {
             let node = &nodes[current.index as usize];
-            let limit = R8::<I>::load(&t_limit[..]) * R8::<I>::splat(BOX_SLACK);
+            let limit = t_limit * R8::<I>::splat(BOX_SLACK);
             let mut entered_slots = 0u32;
             // The node's entry and exit planes, as one ray's traversal computes them, then
             // lane by lane.
@@ -305,13 +307,13 @@ pub fn traverse_packet<I: Isa>(
                 continue;
             }
         } else {
-            visitor.leaf(current.index, current.count, current.rays, t_limit);
-            reach = (R8::<I>::load(&t_limit[..]) * R8::<I>::splat(BOX_SLACK)).max_lane();
+            visitor.leaf(current.index, current.count, current.rays, &mut t_limit);
+            reach = (t_limit * R8::<I>::splat(BOX_SLACK)).max_lane();
         }
         loop {
             let Some(pending) = stack.pop() else { return };
             // Only the rays that have found nothing nearer than where the box is entered go on.
-            let limit = R8::<I>::load(&t_limit[..]) * R8::<I>::splat(BOX_SLACK);
+            let limit = t_limit * R8::<I>::splat(BOX_SLACK);
             let rays = R8::<I>::splat(pending.t).le(limit).bits() & pending.rays;
             if rays != 0 {
                 current = PacketPending { rays, ..pending };

@@ -262,7 +262,7 @@ fn interleaved_rays_each_visit_what_they_visit_alone() {
 struct PacketLog(Vec<(usize, u32, u32)>);
 
 impl<I: Isa> PacketVisitor<I> for PacketLog {
-    fn leaf(&mut self, first: u32, count: u32, rays: u32, _t_limit: &mut [Real; PACKET]) {
+    fn leaf(&mut self, first: u32, count: u32, rays: u32, _t_limit: &mut R8<I>) {
         for lane in 0..PACKET {
             if rays >> lane & 1 != 0 {
                 self.0.push((lane, first, count));
@@ -292,8 +292,7 @@ impl Kernel for AloneAndPacket<'_> {
         }
         let lanes = PacketLanes::<I>::new(self.rays).expect("rays that make a packet");
         let mut packet = PacketLog(Vec::new());
-        let mut t_limit = self.t_max;
-        traverse_packet::<I>(self.nodes, &lanes, (1 << self.rays.len()) - 1, &mut t_limit, &mut packet);
+        traverse_packet::<I>(self.nodes, &lanes, (1 << self.rays.len()) - 1, &self.t_max, &mut packet);
         (alone, packet)
     }
 }
@@ -377,7 +376,7 @@ impl Kernel for EveryTraversal<'_> {
         let interleaved = logs.pop().expect("rays");
         let lanes = PacketLanes::<I>::new(self.rays).expect("rays that make a packet");
         let mut packet = PacketLog(Vec::new());
-        traverse_packet::<I>(self.nodes, &lanes, (1 << self.rays.len()) - 1, &mut [Real::INFINITY; PACKET], &mut packet);
+        traverse_packet::<I>(self.nodes, &lanes, (1 << self.rays.len()) - 1, &[Real::INFINITY; PACKET], &mut packet);
         let packet = packet.0.iter().filter(|&&(lane, ..)| lane == 0).map(|&(_, first, count)| (first, count)).collect();
         [alone, interleaved, packet]
     }

@@ -76,21 +76,18 @@ fn nearest_in_packs<I: Isa>(
         while lanes != 0 {
             let lane = lanes.trailing_zeros() as usize;
             lanes &= lanes - 1;
-            keep_nearer(&values, lane, pack.id(lane), t_limit, closest);
+            if keep_nearer(&values, lane, pack.id(lane), closest) {
+                *t_limit = values[0][lane];
+            }
         }
     }
 }
 
-/// Keeps the hit in `lane` of `values` (on `triangle`) in `closest`, and its `t` in `t_limit`,
-/// when it is nearer than the hit kept: the smaller triangle index among hits at the same `t`.
+/// Keeps the hit in `lane` of `values` (on `triangle`) in `closest` when it is nearer than the
+/// hit kept (the smaller triangle index among hits at the same `t`), and says whether it did:
+/// the ray's limit is then the hit's `t`.
 #[inline(always)]
-fn keep_nearer<const N: usize>(
-    values: &[[Real; N]; 5],
-    lane: usize,
-    triangle: u32,
-    t_limit: &mut Real,
-    closest: &mut Option<MeshHit>,
-) {
+fn keep_nearer<const N: usize>(values: &[[Real; N]; 5], lane: usize, triangle: u32, closest: &mut Option<MeshHit>) -> bool {
     let t = values[0][lane];
     let nearer = match closest {
         Some(best) => t < best.t || (t == best.t && triangle < best.triangle),
@@ -98,9 +95,15 @@ fn keep_nearer<const N: usize>(
     };
     if nearer {
         let hit = lane_hit(values, lane);
-        *t_limit = t;
         *closest = Some(MeshHit { t, triangle, barycentrics: [hit.b0, hit.b1, hit.b2] });
     }
+    nearer
+}
+
+/// `limits` with lane `ray` set to `t`, in lanes (see [`PacketVisitor`]).
+#[inline(always)]
+fn with_limit<I: Isa>(limits: R8<I>, ray: usize, t: Real) -> R8<I> {
+    R8::<I>::select(R8::<I>::mask(1 << ray), R8::<I>::splat(t), limits)
 }
 
 /// The leaf test of [`Mesh::occluded`]: stops at the first pack with a hit.
@@ -144,7 +147,7 @@ pub(super) struct NearestTriangles<'a, I: Isa> {
 
 impl<I: Isa> PacketVisitor<I> for NearestTriangles<'_, I> {
     #[inline(always)]
-    fn leaf(&mut self, first: u32, count: u32, rays: u32, t_limit: &mut [Real; PACKET]) {
+    fn leaf(&mut self, first: u32, count: u32, rays: u32, t_limit: &mut R8<I>) {
         // A leaf reached by few rays tests its packs against two of them at a time (four
         // triangles each), and a last one alone, rather than each triangle against all eight
         // lanes. Every test gives each ray the same hits, bit for bit.
@@ -155,7 +158,11 @@ impl<I: Isa> PacketVisitor<I> for NearestTriangles<'_, I> {
                 remaining &= remaining - 1;
                 if remaining == 0 {
                     let ray = self.rays.pack_ray(lane);
-                    nearest_in_packs(self.mesh, first, count, &ray, &mut t_limit[lane], &mut self.closest[lane]);
+                    let mut limits = [0.0; PACKET];
+                    t_limit.store(&mut limits);
+                    let mut limit = limits[lane];
+                    nearest_in_packs(self.mesh, first, count, &ray, &mut limit, &mut self.closest[lane]);
+                    *t_limit = with_limit::<I>(*t_limit, lane, limit);
                     break;
                 }
                 let other = remaining.trailing_zeros() as usize;
@@ -169,18 +176,22 @@ impl<I: Isa> PacketVisitor<I> for NearestTriangles<'_, I> {
             while live != 0 {
                 let triangle = live.trailing_zeros() as usize;
                 live &= live - 1;
-                let found = intersect_triangle_rays::<I>(pack, triangle, &self.rays, R8::<I>::load(&t_limit[..]));
-                let mut lanes = found.lanes & rays;
-                if lanes == 0 {
+                let found = intersect_triangle_rays::<I>(pack, triangle, &self.rays, *t_limit);
+                let hits = found.lanes & rays;
+                if hits == 0 {
                     continue;
                 }
                 let values = found.values::<8>();
                 let id = pack.id(triangle);
+                let mut lanes = hits;
                 while lanes != 0 {
                     let lane = lanes.trailing_zeros() as usize;
                     lanes &= lanes - 1;
-                    keep_nearer(&values, lane, id, &mut t_limit[lane], &mut self.closest[lane]);
+                    keep_nearer(&values, lane, id, &mut self.closest[lane]);
                 }
+                // A lane per ray, each hit no farther than its ray's limit, which is its kept
+                // hit's `t`: kept or tied, the ray's limit is now the hit's `t`.
+                *t_limit = R8::<I>::select(R8::<I>::mask(hits), found.t(), *t_limit);
             }
         }
     }
@@ -196,9 +207,9 @@ impl<I: Isa> NearestTriangles<'_, I> {
     /// tested against both ([`intersect_pack_pair`]), their hits kept ray by ray in lane order
     /// as the one-ray loop keeps them.
     #[inline(always)]
-    fn nearest_in_packs_pair(&mut self, first: u32, count: u32, pair: [usize; 2], t_limit: &mut [Real; PACKET]) {
+    fn nearest_in_packs_pair(&mut self, first: u32, count: u32, pair: [usize; 2], t_limit: &mut R8<I>) {
         for pack in &self.mesh.packs[first as usize..(first + count) as usize] {
-            let found = intersect_pack_pair::<I>(pack, &self.rays, pair, R8::<I>::load(&t_limit[..]));
+            let found = intersect_pack_pair::<I>(pack, &self.rays, pair, *t_limit);
             let mut lanes = found.lanes;
             if lanes == 0 {
                 continue;
@@ -208,7 +219,9 @@ impl<I: Isa> NearestTriangles<'_, I> {
                 let lane = lanes.trailing_zeros() as usize;
                 lanes &= lanes - 1;
                 let ray = pair[lane / 4];
-                keep_nearer(&values, lane, pack.id(lane % 4), &mut t_limit[ray], &mut self.closest[ray]);
+                if keep_nearer(&values, lane, pack.id(lane % 4), &mut self.closest[ray]) {
+                    *t_limit = with_limit::<I>(*t_limit, ray, values[0][lane]);
+                }
             }
         }
     }

@@ -110,6 +110,12 @@ pub type PackHits<I> = LaneHits<R4<I>>;
 pub type RayHits<I> = LaneHits<R8<I>>;
 
 impl<L: Lanes<Elem = Real>> LaneHits<L> {
+    /// Each lane's `t`; meaningful for `lanes` only.
+    #[inline(always)]
+    pub fn t(&self) -> L {
+        self.t
+    }
+
     /// What each lane's hit is made of: `t`, the three edge functions and the inverse
     /// determinant; meaningful for `lanes` only. `N` is the lane count.
     #[inline(always)]
