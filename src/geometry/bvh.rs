@@ -97,8 +97,9 @@ impl<I: Isa, F: FnMut(u32, u32, &mut Real) -> Visit> LeafVisitor<I> for VisitFn<
 pub trait PacketVisitor<I: Isa> {
     fn leaf(&mut self, first: u32, count: u32, rays: u32, t_limit: &mut R8<I>);
 
-    /// Called when a leaf is put on the packet's stack, so that its primitives can be asked for
-    /// from memory while the nearer children are visited (a hint: it must change nothing).
+    /// Called for each leaf the packet enters, as soon as it is found entered, so that its
+    /// primitives can be asked for from memory before they are tested (a hint: it must change
+    /// nothing).
     #[inline(always)]
     fn prefetch(&self, _first: u32, _count: u32) {}
 }
