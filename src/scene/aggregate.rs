@@ -219,8 +219,8 @@ impl Aggregate {
             Rest::Few { boxes, objects } => {
                 let (hits, t) = boxes.entered::<I>(ray, closest.t);
                 if hits != 0 {
-                    let (keys, count) = BoxSet::nearest_first(hits, &t);
-                    for &key in &keys[..count] {
+                    let mut keys = [0; WIDTH];
+                    for &key in BoxSet::nearest_first(hits, &t, &mut keys) {
                         let lane = BoxSet::lane(key);
                         if !BoxSet::may_hold(t[lane], closest.t) {
                             break;

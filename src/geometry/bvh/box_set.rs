@@ -80,10 +80,11 @@ impl BoxSet {
     }
 
     /// The boxes of `hits` (from [`BoxSet::entered`]) nearest first, in the low bits of keys
-    /// that sort by entry distance; `count` of them.
+    /// that sort by entry distance: the first of `keys`, one a box. Sorted in the caller's
+    /// array and read there: an array returned is copied, eight lanes at a time, from keys just
+    /// written one by one, which waits for those writes to reach the cache.
     #[inline(always)]
-    pub fn nearest_first(hits: u32, t: &[Real; WIDTH]) -> ([u64; WIDTH], usize) {
-        let mut keys = [0u64; WIDTH];
+    pub fn nearest_first<'k>(hits: u32, t: &[Real; WIDTH], keys: &'k mut [u64; WIDTH]) -> &'k [u64] {
         let mut count = 0;
         let mut remaining = hits;
         while remaining != 0 {
@@ -98,7 +99,7 @@ impl BoxSet {
             keys[k] = key;
             count += 1;
         }
-        (keys, count)
+        &keys[..count]
     }
 
     /// The box a key of [`BoxSet::nearest_first`] stands for.

@@ -296,8 +296,9 @@ pub fn traverse_packet<I: Isa>(
                     stack.push_if(pending(far), rest != 0);
                     current = pending(near);
                 } else {
-                    let (keys, len) = BoxSet::nearest_first(entered_slots, &child_entry);
-                    for &ordered in keys[1..len].iter().rev() {
+                    let mut keys = [0; WIDTH];
+                    let keys = BoxSet::nearest_first(entered_slots, &child_entry, &mut keys);
+                    for &ordered in keys[1..].iter().rev() {
                         stack.push(pending(BoxSet::lane(ordered)));
                     }
                     current = pending(BoxSet::lane(keys[0]));

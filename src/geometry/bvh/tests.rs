@@ -593,8 +593,8 @@ fn nearest_first_orders_every_set_of_entered_boxes_by_distance_then_lane() {
     ];
     for t in &distance_sets {
         for hits in 0..=u8::MAX as u32 {
-            let (keys, count) = BoxSet::nearest_first(hits, t);
-            let lanes: Vec<usize> = keys[..count].iter().map(|&key| BoxSet::lane(key)).collect();
+            let mut keys = [0; WIDTH];
+            let lanes: Vec<usize> = BoxSet::nearest_first(hits, t, &mut keys).iter().map(|&key| BoxSet::lane(key)).collect();
             let mut expected: Vec<usize> = (0..WIDTH).filter(|&lane| hits >> lane & 1 != 0).collect();
             expected.sort_by(|&a, &b| t[a].total_cmp(&t[b]).then(a.cmp(&b)));
             assert_eq!(lanes, expected, "hits {hits:08b}, distances {t:?}");

@@ -375,8 +375,9 @@ fn nearest_child<I: Isa>(
         return child(near);
     }
     // More: sort keys that order by entry distance and carry the lane, nearest first.
-    let (keys, len) = BoxSet::nearest_first(hits, &t);
-    for &key in keys[1..len].iter().rev() {
+    let mut keys = [0; WIDTH];
+    let keys = BoxSet::nearest_first(hits, &t, &mut keys);
+    for &key in keys[1..].iter().rev() {
         let waiting = child(key as usize & (WIDTH - 1));
         fetch::<I, _>(nodes, &waiting, visitor);
         stack.push(waiting);

@@ -78,8 +78,8 @@ impl FlatLeaves {
             visitor.leaf(first, count, &mut t_limit);
             return;
         }
-        let (keys, count) = BoxSet::nearest_first(hits, t);
-        for &key in &keys[..count] {
+        let mut keys = [0; WIDTH];
+        for &key in BoxSet::nearest_first(hits, t, &mut keys) {
             let lane = BoxSet::lane(key);
             if !BoxSet::may_hold(t[lane], t_limit) {
                 break;
