@@ -177,10 +177,10 @@ struct PacketPending {
 /// own `t_limit`). Children are visited nearest first (by the nearest ray's entry, or the packet's
 /// frustum's bound on it). Boxes that no ray of the packet can enter by the frustum's test are
 /// not tested ray by ray; each child entered is asked for from memory as soon as it is found
-/// entered, the nearest too (it gets a head start of the ordering). `visit(first,
-/// count, rays, t_limit)` is called for each leaf with the rays (bits) that reached it and their
-/// limits in lanes, starting from `t_max`; it may shrink the rays' limits, which prunes, ray by
-/// ray, every box entered beyond.
+/// entered, the nearest too (it gets a head start of the ordering). `visit(first, count, rays,
+/// t_limit)` is called for each leaf with the rays (bits) that reached it and their limits in
+/// lanes, starting from `t_max`; it may shrink the rays' limits, which prunes, ray by ray,
+/// every box entered beyond.
 ///
 /// A kernel: compile it only inside one (see `crate::simd`).
 // The slab test's loop over the axes indexes the planes and four of the packet's arrays.
