@@ -162,15 +162,10 @@ impl Mesh {
     /// # Panics
     /// If there are more than [`PACKET`] rays.
     pub fn intersect_packet(&self, rays: &[Ray], t_max: Real) -> [Option<MeshHit>; PACKET] {
-        struct Closest<'a>(&'a Mesh, &'a [Ray], Real);
-        impl Kernel for Closest<'_> {
-            type Output = [Option<MeshHit>; PACKET];
-            #[inline(always)]
-            fn run<I: Isa>(self) -> [Option<MeshHit>; PACKET] {
-                self.0.closest_packet::<I>(self.1, &[self.2; PACKET])
-            }
-        }
-        dispatch(Closest(self, rays, t_max))
+        assert!(rays.len() <= PACKET, "a packet holds at most {PACKET} rays");
+        let mut hits = [None; PACKET];
+        self.intersect_packets(rays, t_max, &mut hits);
+        hits
     }
 
     /// [`Mesh::intersect_packet`] of every run of [`PACKET`] rays of `rays` in turn (the last

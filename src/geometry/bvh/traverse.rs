@@ -378,9 +378,9 @@ fn nearest_child<I: Isa>(
     let mut keys = [0; WIDTH];
     let keys = BoxSet::nearest_first(hits, &t, &mut keys);
     for &key in keys[1..].iter().rev() {
-        let waiting = child(key as usize & (WIDTH - 1));
+        let waiting = child(BoxSet::lane(key));
         fetch::<I, _>(nodes, &waiting, visitor);
         stack.push(waiting);
     }
-    child(keys[0] as usize & (WIDTH - 1))
+    child(BoxSet::lane(keys[0]))
 }
