@@ -2,7 +2,7 @@
 
 use super::super::Ray;
 use super::super::lanes::RayLanes;
-use super::super::real::{R8, Real};
+use super::super::real::{R8, Real, lane_pair};
 use crate::simd::{Isa, Lanes, MaskOps};
 use super::*;
 use super::traverse::{StackSpace, prefetch_node, sort_key};
@@ -210,15 +210,11 @@ pub fn traverse_packet<I: Isa>(
             let node = &nodes[current.index as usize];
             let limit = t_limit * R8::<I>::splat(BOX_SLACK);
             let mut entered_slots = 0u32;
-            // The node's entry and exit planes, as one ray's traversal computes them, then
-            // lane by lane.
+            // The node's entry and exit planes, as one ray's traversal computes them; each box's
+            // are spread across the lanes by one permutation a plane (`vpermps`), not stored
+            // and each read back as a broadcast (camera rays through the 1M-triangle mesh 1.1%
+            // faster on one thread, 1-2% on two).
             let plane_lanes = lanes.entry_exit(node);
-            let mut planes = [[[0.0; WIDTH]; 3]; 2];
-            for side in 0..2 {
-                for axis in 0..3 {
-                    plane_lanes[side][axis].store(&mut planes[side][axis]);
-                }
-            }
             let mut used = node.used();
             // With a frustum, the boxes are ordered by its entry distances, each no farther
             // than the nearest ray's (the order only decides how soon a box is visited).
@@ -237,8 +233,8 @@ pub fn traverse_packet<I: Isa>(
                 let mut t_enter = R8::<I>::splat(0.0);
                 let mut t_exit = limit;
                 for axis in 0..3 {
-                    let near = R8::<I>::splat(planes[0][axis][slot]);
-                    let far = R8::<I>::splat(planes[1][axis][slot]);
+                    let near = lane_pair::<I>(plane_lanes[0][axis], [slot, slot]);
+                    let far = lane_pair::<I>(plane_lanes[1][axis], [slot, slot]);
                     let t_near = (near - lanes.origin[axis]) * lanes.inverse[axis];
                     let t_far = (far - lanes.origin[axis]) * lanes.far_inverse[axis];
                     t_enter = t_near.max(t_enter);
