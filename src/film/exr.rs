@@ -109,9 +109,9 @@ fn film_image(film: &Film) -> Image<Layer<AnyChannels<FlatSamples>>> {
 }
 
 /// What the exr crate's `to_buffered` writes, each block compressed on rayon's pool: ZIP
-/// compression on one thread was two thirds of the time of writing a 512×512 film with
-/// variance (about 100 ms against a 50 ms render). The crate's own parallel writer would build
-/// a fresh thread pool for every file, under a grading that already runs a film a thread. The
+/// compression on one thread was most of the time of writing a 512×512 film with variance
+/// (about 100 ms, against a 50 ms render). The crate's own parallel writer would build a fresh
+/// thread pool for every file, beside the pool whose threads are writing films already. The
 /// blocks are made and written in the order the sequential writer takes them, and a block's
 /// compression depends on the block alone, so the bytes are those of the sequential writer
 /// whatever the threads.
