@@ -183,7 +183,8 @@ struct PacketPending {
 /// every box entered beyond.
 ///
 /// A kernel: compile it only inside one (see `crate::simd`).
-// The slab test's loop over the axes indexes the planes and four of the packet's arrays.
+// The slab test's loop over the axes indexes the node's plane lanes and three of the packet's
+// arrays.
 #[allow(clippy::needless_range_loop)]
 #[inline(always)]
 pub fn traverse_packet<I: Isa>(
