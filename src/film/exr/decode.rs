@@ -21,6 +21,11 @@ use super::VARIANCE_CHANNELS;
 /// seven channels: far beyond any golden image, far below a header typo.
 const MAX_DECODE_BYTES: usize = 1 << 30;
 
+/// Blocks inflated side by side at a time: enough to keep every thread busy (an 800×800 film
+/// has 50), few enough that a large file's samples are not held twice over, once inflated in
+/// blocks and once in the layer's channels.
+const BLOCKS_AT_ONCE: usize = 64;
+
 /// The layer goldray reads: the first valid one, at its largest resolution, every channel.
 type FirstLayer = Layer<AnyChannels<FlatSamples>>;
 
@@ -59,7 +64,8 @@ pub(super) fn decode_exr_named(bytes: &[u8], file: &str) -> Result<Film, OutputE
 /// own parallel reader builds a fresh thread pool for every file, and its sequential one leaves
 /// the other cores idle while a film's blocks are inflated one after another (the twin of
 /// `write_compressed_in_parallel`). A block's decompression depends on the block alone, so the
-/// samples are the sequential reader's whatever the threads.
+/// samples are the sequential reader's whatever the threads. The blocks go [`BLOCKS_AT_ONCE`]
+/// at a time, in the file's order.
 fn read_first_layer(bytes: &[u8]) -> ::exr::error::Result<FirstLayer> {
     let wanted = read()
         .no_deep_data()
@@ -69,15 +75,22 @@ fn read_first_layer(bytes: &[u8]) -> ::exr::error::Result<FirstLayer> {
     let chunks = ::exr::block::read(Cursor::new(bytes), false)?;
     let meta = chunks.meta_data().clone();
     let mut layers = wanted.create_layers_reader(chunks.headers())?;
-    let compressed: Vec<Chunk> = chunks
-        .filter_chunks(false, |meta, tile, block| layers.filter_block(meta, tile, block))?
-        .collect::<::exr::error::Result<_>>()?;
-    let blocks: Vec<UncompressedBlock> = compressed
-        .into_par_iter()
-        .map(|chunk| UncompressedBlock::decompress_chunk(chunk, &meta, false))
-        .collect::<::exr::error::Result<_>>()?;
-    for block in blocks {
-        layers.read_block(&meta.headers, block)?;
+    let mut chunks = chunks.filter_chunks(false, |meta, tile, block| layers.filter_block(meta, tile, block))?;
+    loop {
+        let compressed: Vec<Chunk> = chunks
+            .by_ref()
+            .take(BLOCKS_AT_ONCE)
+            .collect::<::exr::error::Result<_>>()?;
+        if compressed.is_empty() {
+            break;
+        }
+        let blocks: Vec<UncompressedBlock> = compressed
+            .into_par_iter()
+            .map(|chunk| UncompressedBlock::decompress_chunk(chunk, &meta, false))
+            .collect::<::exr::error::Result<_>>()?;
+        for block in blocks {
+            layers.read_block(&meta.headers, block)?;
+        }
     }
     Ok(layers.into_layers())
 }
@@ -142,8 +155,9 @@ mod tests {
     use super::*;
 
     /// An EXR of another tool's kind: 16-bit colour, 32-bit depth, an integer channel goldray
-    /// ignores, PIZ-compressed in blocks of 32 lines, the last short.
-    fn foreign_exr() -> Vec<u8> {
+    /// ignores, 101 lines compressed with `compression` (PIZ: blocks of 32 lines, the last
+    /// short; ZIP1: 101 blocks of a line, more than [`BLOCKS_AT_ONCE`]).
+    fn foreign_exr(compression: Compression) -> Vec<u8> {
         let (width, height) = (45, 101);
         let value = |k: usize, salt: usize| ((k * 7919 + salt * 104_729) % 1013) as f32 / 97.0;
         let half = |salt| FlatSamples::F16((0..width * height).map(|k| f16::from_f32(value(k, salt))).collect());
@@ -158,7 +172,7 @@ mod tests {
             AnyChannel::new("id", FlatSamples::U32((0..width * height).map(|k| k as u32).collect())),
         ];
         let encoding = Encoding {
-            compression: Compression::PIZ,
+            compression,
             blocks: Blocks::ScanLines,
             line_order: LineOrder::Increasing,
         };
@@ -180,33 +194,39 @@ mod tests {
 
     #[test]
     fn blocks_decompressed_side_by_side_give_the_sequential_readers_samples() {
-        let bytes = foreign_exr();
-        let sequential = read()
-            .no_deep_data()
-            .largest_resolution_level()
-            .all_channels()
-            .first_valid_layer()
-            .all_attributes()
-            .non_parallel()
-            .from_buffered(Cursor::new(&bytes))
-            .unwrap();
-        let expected = film_from_layer(&sequential.layer_data, "expected").unwrap();
-        assert!(expected.depth.iter().any(|&z| z != expected.depth[0]));
-        for threads in [1, 4] {
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-            let layer = pool.install(|| read_first_layer(&bytes)).unwrap();
-            assert!(layer == sequential.layer_data, "{threads} threads: the layer differs");
-            assert_eq!(
-                pool.install(|| decode_exr(&bytes)).unwrap(),
-                expected,
-                "{threads} threads"
-            );
+        const { assert!(101 > BLOCKS_AT_ONCE, "ZIP1 makes more blocks than one batch") };
+        for compression in [Compression::PIZ, Compression::ZIP1] {
+            let bytes = foreign_exr(compression);
+            let sequential = read()
+                .no_deep_data()
+                .largest_resolution_level()
+                .all_channels()
+                .first_valid_layer()
+                .all_attributes()
+                .non_parallel()
+                .from_buffered(Cursor::new(&bytes))
+                .unwrap();
+            let expected = film_from_layer(&sequential.layer_data, "expected").unwrap();
+            assert!(expected.depth.iter().any(|&z| z != expected.depth[0]));
+            for threads in [1, 4] {
+                let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+                let layer = pool.install(|| read_first_layer(&bytes)).unwrap();
+                assert!(
+                    layer == sequential.layer_data,
+                    "{compression:?}, {threads} threads: the layer differs"
+                );
+                assert_eq!(
+                    pool.install(|| decode_exr(&bytes)).unwrap(),
+                    expected,
+                    "{compression:?}, {threads} threads"
+                );
+            }
         }
     }
 
     #[test]
     fn a_cut_off_file_is_an_error_naming_it() {
-        let mut bytes = foreign_exr();
+        let mut bytes = foreign_exr(Compression::PIZ);
         bytes.truncate(bytes.len() - 100);
         let error = decode_exr_named(&bytes, "student.exr").unwrap_err();
         assert!(error.to_string().contains("student.exr"), "{error}");
