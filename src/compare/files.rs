@@ -46,15 +46,18 @@ pub struct FileComparison {
     pub comparison: Comparison,
 }
 
-/// Reads both files and compares them under `overrides` (defaults by the expected file's
-/// encoding).
+/// Reads both files, side by side, and compares them under `overrides` (defaults by the
+/// expected file's encoding). When both are unreadable, the expected file's error is reported.
 pub fn compare_files(
     expected: &Path,
     actual: &Path,
     overrides: &ToleranceOverrides,
 ) -> Result<FileComparison, CompareError> {
-    let expected = Image::read(expected)?;
-    let actual = Image::read(actual)?;
+    // Side by side: a PNG is decoded on one thread, and an EXR's reading is not all parallel
+    // (`goldray diff` of two 800×800 PNGs 9.8-15.9 -> 7.4-8.9 ms, of an 800×800 EXR with
+    // itself 115-130 -> 103-119 ms).
+    let (expected, actual) = rayon::join(|| Image::read(expected), || Image::read(actual));
+    let (expected, actual) = (expected?, actual?);
     let tolerance = overrides.tolerance(expected.encoding);
     let comparison = compare(&expected, &actual, &tolerance);
     Ok(FileComparison {
@@ -80,5 +83,30 @@ impl FileComparison {
         })?;
         self.comparison.diff_image = Some(path.to_path_buf());
         Ok(true)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_unreadable_file_is_named_the_expected_first_when_both_are() {
+        let dir = tempfile::tempdir().unwrap();
+        let [missing_expected, missing_actual] = ["golden.exr", "student.png"].map(|name| dir.path().join(name));
+        let overrides = ToleranceOverrides::default();
+        let both = compare_files(&missing_expected, &missing_actual, &overrides)
+            .unwrap_err()
+            .to_string();
+        assert!(both.contains("golden.exr") && !both.contains("student.png"), "{both}");
+
+        let readable = dir.path().join("golden.png");
+        write_png(&readable, &crate::rgb_image::RgbImage::new(4, 3)).unwrap();
+        let one = compare_files(&readable, &missing_actual, &overrides)
+            .unwrap_err()
+            .to_string();
+        assert!(one.contains("student.png"), "{one}");
+        let same = compare_files(&readable, &readable, &overrides).unwrap();
+        assert_eq!((same.expected.width, same.actual.height), (4, 3));
     }
 }
