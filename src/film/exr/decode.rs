@@ -40,6 +40,9 @@ pub(super) fn decode_exr_named(bytes: &[u8], file: &str) -> Result<Film, OutputE
         reason,
     };
 
+    // The header read on its own, unvalidated, so that a size no film could have is refused
+    // with its own reason; the block reader below reads it again and validates it, and would
+    // refuse such a header only as a chunk count not matching the file.
     let meta = MetaData::read_from_buffered(bytes, false).map_err(invalid)?;
     let claimed = meta.headers.iter().try_fold(0usize, |total, header| {
         let layer = header.layer_size.area().checked_mul(header.channels.bytes_per_pixel)?;
