@@ -30,6 +30,7 @@ pub mod run;
 pub mod sandbox;
 pub mod simd;
 pub mod stats;
+pub mod texel_cache;
 pub mod tradeoff;
 
 pub use error::Error;

@@ -14,6 +14,7 @@ const LAYERS: &[(&str, u32)] = &[
     ("simd", 0),
     ("html_escape", 0),
     ("rgb_image", 0),
+    ("texel_cache", 0),
     ("located_toml", 1),
     ("build_error", 2),
     ("options", 2),

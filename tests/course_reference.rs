@@ -241,6 +241,71 @@ fn the_course_command_line_rejects_what_the_course_binary_would() {
     );
 }
 
+/// Scene 7's pictures (which look at two faces of the course's cube map) rendered with
+/// `GOLDRAY_TEXEL_CACHE` set to `cache`.
+fn scene07_pictures(cache: &Path, out: &Path) -> Vec<Vec<u8>> {
+    let scene = scene_path("scene07_arch.txt");
+    let files = ["a07.png", "a07n.png", "a07d.png"].map(|name| out.join(name));
+    let [color, normals, depth] = files.each_ref().map(|path| path.to_str().unwrap());
+    let arguments = [
+        "mit6837",
+        "-size",
+        "200",
+        "200",
+        "-input",
+        scene.to_str().unwrap(),
+        "-output",
+        color,
+    ];
+    let rendered = Command::new(env!("CARGO_BIN_EXE_goldray"))
+        .env("GOLDRAY_TEXEL_CACHE", cache)
+        .args(arguments)
+        .args([
+            "-normals", normals, "-depth", "8", "18", depth, "-bounces", "4", "-shadows", "--quiet",
+        ])
+        .output()
+        .unwrap();
+    assert!(rendered.status.success(), "{}", util::stderr(&rendered));
+    files.iter().map(|path| fs::read(path).unwrap()).collect()
+}
+
+#[test]
+fn the_texel_cache_changes_no_byte_of_any_picture() {
+    let dir = tempfile::tempdir().unwrap();
+    let cache = dir.path().join("texels");
+    let uncached = scene07_pictures(Path::new("off"), dir.path());
+    assert!(!cache.exists());
+    assert_eq!(
+        scene07_pictures(&cache, dir.path()),
+        uncached,
+        "faces decoded and stored"
+    );
+    let entries: Vec<PathBuf> = fs::read_dir(&cache)
+        .unwrap()
+        .map(|entry| entry.unwrap().path())
+        .collect();
+    assert_eq!(entries.len(), 2, "the two faces the scene sees: {entries:?}");
+    assert_eq!(
+        scene07_pictures(&cache, dir.path()),
+        uncached,
+        "faces read from the cache"
+    );
+    let contents = |paths: &[PathBuf]| paths.iter().map(|path| fs::read(path).unwrap()).collect::<Vec<_>>();
+    let stored = contents(&entries);
+    for entry in &entries {
+        let mut bytes = fs::read(entry).unwrap();
+        let middle = bytes.len() / 2;
+        bytes[middle] ^= 0x40;
+        fs::write(entry, bytes).unwrap();
+    }
+    assert_eq!(
+        scene07_pictures(&cache, dir.path()),
+        uncached,
+        "damaged entries decoded again"
+    );
+    assert_eq!(contents(&entries), stored, "and stored again whole");
+}
+
 #[test]
 fn import_refuses_to_overwrite_without_force() {
     let dir = tempfile::tempdir().unwrap();

@@ -19,6 +19,7 @@ mod tradeoff;
 use std::process::ExitCode;
 
 use clap::{CommandFactory, Parser, Subcommand};
+use goldray::texel_cache::TexelCache;
 
 /// A deterministic Whitted ray tracer and scene-to-image regression harness.
 #[derive(Parser)]
@@ -113,6 +114,20 @@ fn keep_freed_memory() {
     crate::allocator::grow_heap_in_large_steps();
 }
 
+/// Keeps decoded cube-map faces between runs (see `goldray::texel_cache`) in the folder
+/// `GOLDRAY_TEXEL_CACHE` names, or in the user's cache folder when it is unset; `off` (or empty)
+/// keeps none. Read here, once, so that the library itself writes nothing unasked.
+fn install_texel_cache() {
+    let dir = match std::env::var_os("GOLDRAY_TEXEL_CACHE") {
+        Some(value) if value.is_empty() || value == "off" => None,
+        Some(value) => Some(std::path::PathBuf::from(value)),
+        None => TexelCache::default_dir(),
+    };
+    if let Some(dir) = dir {
+        TexelCache::new(dir, goldray::texel_cache::DEFAULT_LIMIT_BYTES).install();
+    }
+}
+
 /// Parses the command line (rewriting the course's single-dash flags first), runs the command
 /// and turns its outcome into the process's exit code.
 pub fn main() -> ExitCode {
@@ -125,6 +140,7 @@ pub fn main() -> ExitCode {
         return run::serve_sandbox_init();
     }
     keep_freed_memory();
+    install_texel_cache();
     let args = course_flags::rewrite(std::env::args_os());
     let cli = match Cli::try_parse_from(&args) {
         Ok(cli) => cli,

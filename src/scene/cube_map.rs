@@ -11,6 +11,7 @@ use super::real::{Color, Real, Vec3};
 pub use crate::build_error::CubeMapError;
 use crate::rgb_image::{DEFAULT_MAX_BYTES, decode_png};
 use crate::simd::Isa;
+use crate::texel_cache::TexelCache;
 
 /// One face: a PNG read and checked at load, decoded when a ray first looks at it.
 ///
@@ -27,6 +28,8 @@ struct Face {
     /// Red, green and blue bytes texel by texel, row by row, row 0 at the top; or why the data
     /// could not be decoded.
     texels: OnceLock<Result<Vec<u8>, String>>,
+    /// Where decoded texels are kept between runs, if anywhere.
+    cache: Option<&'static TexelCache>,
 }
 
 #[derive(Debug)]
@@ -50,11 +53,17 @@ fn byte_values() -> &'static [Real; 256] {
 }
 
 impl CubeMap {
-    /// Reads and checks `dir/{left,right,up,down,front,back}.png`, in parallel.
+    /// Reads and checks `dir/{left,right,up,down,front,back}.png`, in parallel; faces are
+    /// decoded through the process's installed [`TexelCache`], if any.
     pub fn load(dir: &Path) -> Result<CubeMap, CubeMapError> {
+        CubeMap::load_cached(dir, TexelCache::installed())
+    }
+
+    /// [`CubeMap::load`] with faces decoded through `cache` (or none).
+    pub fn load_cached(dir: &Path, cache: Option<&'static TexelCache>) -> Result<CubeMap, CubeMapError> {
         let faces: Vec<Face> = FACE_NAMES
             .par_iter()
-            .map(|name| Face::read(dir.join(format!("{name}.png"))))
+            .map(|name| Face::read(dir.join(format!("{name}.png")), cache))
             .collect::<Result<_, _>>()?;
         let faces: [Face; 6] = faces.try_into().expect("six names give six faces");
         Ok(CubeMap { faces })
@@ -150,7 +159,7 @@ impl CubeMap {
 }
 
 impl Face {
-    fn read(path: PathBuf) -> Result<Face, CubeMapError> {
+    fn read(path: PathBuf, cache: Option<&'static TexelCache>) -> Result<Face, CubeMapError> {
         let error = |reason: String| CubeMapError { path: path.clone(), reason };
         let png = std::fs::read(&path).map_err(|e| error(e.to_string()))?;
         check_chunks(&png).map_err(|reason| error(format!("not a valid PNG file: {reason}")))?;
@@ -159,15 +168,23 @@ impl Face {
         if width == 0 || height == 0 {
             return Err(error("the image is empty".to_string()));
         }
-        Ok(Face { path, png, width: width as usize, height: height as usize, texels: OnceLock::new() })
+        Ok(Face { path, png, width: width as usize, height: height as usize, texels: OnceLock::new(), cache })
     }
 
-    /// The decoded texels: decoded by the first ray to look, which any other waits for.
+    /// The decoded texels: decoded (or read from the cache) by the first ray to look, which any
+    /// other waits for. Texels decoded are stored in the cache; a cache that cannot be written
+    /// only means the next run decodes them again.
     fn texels(&self) -> Option<&[u8]> {
         let texels = self.texels.get_or_init(|| {
+            if let Some(texels) = self.cache.and_then(|cache| cache.read(&self.png, self.width, self.height)) {
+                return Ok(texels);
+            }
             let texels = decode_rgb8(&self.png)?;
             if texels.len() != self.width * self.height * 3 {
                 return Err("the image data does not match its header".to_string());
+            }
+            if let Some(cache) = self.cache {
+                let _ = cache.write(&self.png, self.width, self.height, &texels);
             }
             Ok(texels)
         });
@@ -308,7 +325,7 @@ mod tests {
 
     fn face(width: usize, height: usize, texels: Vec<[u8; 3]>) -> Face {
         let texels = OnceLock::from(Ok(texels.into_flattened()));
-        Face { path: PathBuf::new(), png: Vec::new(), width, height, texels }
+        Face { path: PathBuf::new(), png: Vec::new(), width, height, texels, cache: None }
     }
 
     fn uniform_face(byte: u8) -> Face {
@@ -445,6 +462,36 @@ mod tests {
         let error = map.failure().expect("the right face could not be decoded");
         assert!(error.path.ends_with("right.png"), "{error}");
         assert!(map.decode_all().is_err());
+    }
+
+    #[test]
+    fn faces_are_read_from_the_texel_cache_and_stored_there_when_decoded() {
+        let dir = faces_with_a_damaged_right_face(true);
+        let cache_dir = tempfile::tempdir().unwrap();
+        let cache: &'static TexelCache =
+            Box::leak(Box::new(TexelCache::new(cache_dir.path().to_path_buf(), u64::MAX)));
+        let decoded = Color::new(value(200), value(100), value(50));
+        let map = CubeMap::load_cached(dir.path(), Some(cache)).unwrap();
+        assert_eq!(map.radiance(-Vec3::X), decoded);
+        let left = std::fs::read(dir.path().join("left.png")).unwrap();
+        assert_eq!(cache.read(&left, 2, 2), Some([200, 100, 50].repeat(4)), "the decoded face was stored");
+        assert_eq!(map.radiance(Vec3::X), Color::ZERO, "the damaged face still shows black");
+        assert_eq!(std::fs::read_dir(cache_dir.path()).unwrap().count(), 1, "nothing stored for it");
+
+        // Every face but `right` is the same PNG, so one entry serves them all: give it other
+        // texels, and a new map shows those without decoding.
+        cache.write(&left, 2, 2, &[7; 12]).unwrap();
+        let map = CubeMap::load_cached(dir.path(), Some(cache)).unwrap();
+        assert_eq!(map.radiance(Vec3::Y), Color::splat(value(7)), "read from the cache");
+
+        // A damaged entry is decoded again, and repaired.
+        let entry = std::fs::read_dir(cache_dir.path()).unwrap().next().unwrap().unwrap().path();
+        let mut bytes = std::fs::read(&entry).unwrap();
+        *bytes.last_mut().unwrap() ^= 1;
+        std::fs::write(&entry, bytes).unwrap();
+        let map = CubeMap::load_cached(dir.path(), Some(cache)).unwrap();
+        assert_eq!(map.radiance(Vec3::Z), decoded);
+        assert_eq!(cache.read(&left, 2, 2), Some([200, 100, 50].repeat(4)), "repaired");
     }
 
     #[test]

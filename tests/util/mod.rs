@@ -7,9 +7,15 @@ use std::process::{Command, Output};
 
 use goldray::case::{Case, LoadOptions, load};
 
-/// Runs the `goldray` binary with `args` and returns what it did, whatever the exit code.
+/// Runs the `goldray` binary with `args` and returns what it did, whatever the exit code. Decoded
+/// cube-map faces are kept under the build's folder for integration tests, not in the user's
+/// cache folder.
 pub fn goldray(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_goldray"))
+        .env(
+            "GOLDRAY_TEXEL_CACHE",
+            Path::new(env!("CARGO_TARGET_TMPDIR")).join("texels"),
+        )
         .args(args)
         .output()
         .expect("the goldray binary runs")
