@@ -68,7 +68,7 @@ fn rendering<T>(case: &Case, progress: &dyn Progress, render: impl FnOnce(&dyn P
 pub fn render_case_measured(case: &Case, progress: &dyn Progress, aovs: bool) -> Result<MeasuredRender, Error> {
     with_precision!(case.render.precision, p => {
         let start = Instant::now();
-        let (scene, build_stats) = p::scene::build_scene_measured(case)?;
+        let (scene, mut build_stats) = p::scene::build_scene_measured(case)?;
         let build_time = start.elapsed();
         let render_start = Instant::now();
         let options = RenderOptions { aovs, ..render_options(case) };
@@ -76,6 +76,7 @@ pub fn render_case_measured(case: &Case, progress: &dyn Progress, aovs: bool) ->
         if let Some(source) = scene.render_failure() {
             return Err(BuildError::CubeMap { file: case.path.clone(), source }.into());
         }
+        build_stats.cube_map_faces = scene.cube_map_faces();
         Ok(MeasuredRender { film, rays, build_stats, build_time, render_time: render_start.elapsed() })
     })
 }

@@ -242,11 +242,13 @@ fn the_course_command_line_rejects_what_the_course_binary_would() {
 }
 
 /// Scene 7's pictures (which look at two faces of the course's cube map) rendered with
-/// `GOLDRAY_TEXEL_CACHE` set to `cache`.
-fn scene07_pictures(cache: &Path, out: &Path) -> Vec<Vec<u8>> {
+/// `GOLDRAY_TEXEL_CACHE` set to `cache`, and how many faces the render decoded and read from the
+/// cache (from `--stats-json`).
+fn scene07_pictures(cache: &Path, out: &Path) -> (Vec<Vec<u8>>, [u64; 2]) {
     let scene = scene_path("scene07_arch.txt");
     let files = ["a07.png", "a07n.png", "a07d.png"].map(|name| out.join(name));
     let [color, normals, depth] = files.each_ref().map(|path| path.to_str().unwrap());
+    let stats = out.join("stats.json");
     let arguments = [
         "mit6837",
         "-size",
@@ -263,32 +265,36 @@ fn scene07_pictures(cache: &Path, out: &Path) -> Vec<Vec<u8>> {
         .args([
             "-normals", normals, "-depth", "8", "18", depth, "-bounces", "4", "-shadows", "--quiet",
         ])
+        .args(["--stats-json", stats.to_str().unwrap()])
         .output()
         .unwrap();
     assert!(rendered.status.success(), "{}", util::stderr(&rendered));
-    files.iter().map(|path| fs::read(path).unwrap()).collect()
+    let stats: serde_json::Value = serde_json::from_slice(&fs::read(stats).unwrap()).unwrap();
+    let faces = ["decoded", "read_from_cache"].map(|key| stats["cube_map_faces"][key].as_u64().unwrap());
+    (files.iter().map(|path| fs::read(path).unwrap()).collect(), faces)
 }
 
 #[test]
 fn the_texel_cache_changes_no_byte_of_any_picture() {
     let dir = tempfile::tempdir().unwrap();
     let cache = dir.path().join("texels");
-    let uncached = scene07_pictures(Path::new("off"), dir.path());
+    let (uncached, faces) = scene07_pictures(Path::new("off"), dir.path());
+    assert_eq!(faces, [2, 0], "the scene sees two faces");
     assert!(!cache.exists());
     assert_eq!(
         scene07_pictures(&cache, dir.path()),
-        uncached,
-        "faces decoded and stored"
+        (uncached.clone(), [2, 0]),
+        "decoded and stored"
     );
     let entries: Vec<PathBuf> = fs::read_dir(&cache)
         .unwrap()
         .map(|entry| entry.unwrap().path())
         .collect();
-    assert_eq!(entries.len(), 2, "the two faces the scene sees: {entries:?}");
+    assert_eq!(entries.len(), 2, "an entry per face seen: {entries:?}");
     assert_eq!(
         scene07_pictures(&cache, dir.path()),
-        uncached,
-        "faces read from the cache"
+        (uncached.clone(), [0, 2]),
+        "read from the cache"
     );
     let contents = |paths: &[PathBuf]| paths.iter().map(|path| fs::read(path).unwrap()).collect::<Vec<_>>();
     let stored = contents(&entries);
@@ -300,7 +306,7 @@ fn the_texel_cache_changes_no_byte_of_any_picture() {
     }
     assert_eq!(
         scene07_pictures(&cache, dir.path()),
-        uncached,
+        (uncached, [2, 0]),
         "damaged entries decoded again"
     );
     assert_eq!(contents(&entries), stored, "and stored again whole");

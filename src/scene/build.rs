@@ -89,7 +89,7 @@ pub fn build_scene_measured(case: &Case) -> Result<(Scene, BuildStats), BuildErr
         materials,
         geometry,
     };
-    Ok((scene, BuildStats { cube_map_load_time, meshes: builder.mesh_stats, scene_bvh }))
+    Ok((scene, BuildStats { cube_map_load_time, cube_map_faces: None, meshes: builder.mesh_stats, scene_bvh }))
 }
 
 /// A BVH's shape for `--stats`. Assembled here, above both, so that the geometry does not know the

@@ -4,6 +4,7 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 use rayon::prelude::*;
 
@@ -11,6 +12,7 @@ use super::real::{Color, Real, Vec3};
 pub use crate::build_error::CubeMapError;
 use crate::rgb_image::{DEFAULT_MAX_BYTES, decode_png};
 use crate::simd::Isa;
+use crate::stats::CubeMapFaces;
 use crate::texel_cache::TexelCache;
 
 /// One face: a PNG read and checked at load, decoded when a ray first looks at it.
@@ -30,6 +32,8 @@ struct Face {
     texels: OnceLock<Result<Vec<u8>, String>>,
     /// Where decoded texels are kept between runs, if anywhere.
     cache: Option<&'static TexelCache>,
+    /// Whether `texels` were read from the cache rather than decoded (for `--stats`).
+    from_cache: AtomicBool,
 }
 
 #[derive(Debug)]
@@ -148,6 +152,21 @@ impl CubeMap {
         self.failure().map_or(Ok(()), Err)
     }
 
+    /// How the faces rays looked at so far came to be: decoded from their PNG, or read from the
+    /// texel cache.
+    pub fn faces_loaded(&self) -> CubeMapFaces {
+        let mut faces = CubeMapFaces::default();
+        for face in &self.faces {
+            if let Some(Ok(_)) = face.texels.get() {
+                match face.from_cache.load(Ordering::Relaxed) {
+                    true => faces.read_from_cache += 1,
+                    false => faces.decoded += 1,
+                }
+            }
+        }
+        faces
+    }
+
     /// A face that a ray looked at but that could not be decoded (it showed black): the render
     /// that saw it must be discarded. `None` when every face seen so far was decoded.
     pub fn failure(&self) -> Option<CubeMapError> {
@@ -168,7 +187,7 @@ impl Face {
         if width == 0 || height == 0 {
             return Err(error("the image is empty".to_string()));
         }
-        Ok(Face { path, png, width: width as usize, height: height as usize, texels: OnceLock::new(), cache })
+        Ok(Face { path, png, width: width as usize, height: height as usize, texels: OnceLock::new(), cache, from_cache: AtomicBool::new(false) })
     }
 
     /// The decoded texels: decoded (or read from the cache) by the first ray to look, which any
@@ -177,6 +196,7 @@ impl Face {
     fn texels(&self) -> Option<&[u8]> {
         let texels = self.texels.get_or_init(|| {
             if let Some(texels) = self.cache.and_then(|cache| cache.read(&self.png, self.width, self.height)) {
+                self.from_cache.store(true, Ordering::Relaxed);
                 return Ok(texels);
             }
             let texels = decode_rgb8(&self.png)?;
@@ -325,7 +345,7 @@ mod tests {
 
     fn face(width: usize, height: usize, texels: Vec<[u8; 3]>) -> Face {
         let texels = OnceLock::from(Ok(texels.into_flattened()));
-        Face { path: PathBuf::new(), png: Vec::new(), width, height, texels, cache: None }
+        Face { path: PathBuf::new(), png: Vec::new(), width, height, texels, cache: None, from_cache: AtomicBool::new(false) }
     }
 
     fn uniform_face(byte: u8) -> Face {

@@ -20,6 +20,8 @@ use light::Light;
 use material::Material;
 use real::{Color, Vec3};
 
+use crate::stats::CubeMapFaces;
+
 /// What a ray that hits nothing sees.
 #[derive(Debug)]
 pub enum Background {
@@ -45,6 +47,14 @@ impl Scene {
     pub fn render_failure(&self) -> Option<CubeMapError> {
         match &self.background {
             Background::CubeMap(map) => map.failure(),
+            Background::Color(_) => None,
+        }
+    }
+
+    /// The cube map faces decoded and read from the texel cache so far; `None` without a cube map.
+    pub fn cube_map_faces(&self) -> Option<CubeMapFaces> {
+        match &self.background {
+            Background::CubeMap(map) => Some(map.faces_loaded()),
             Background::Color(_) => None,
         }
     }

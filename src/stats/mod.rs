@@ -56,10 +56,21 @@ pub struct BuildStats {
     /// Reading the six faces of the background's cube map, when it has one.
     #[serde(rename = "cube_map_load_seconds", serialize_with = "optional_seconds")]
     pub cube_map_load_time: Option<Duration>,
+    /// The cube map's faces that rays looked at, by how each was loaded (known once the render
+    /// is done).
+    pub cube_map_faces: Option<CubeMapFaces>,
     /// In the order the case first uses them.
     pub meshes: Vec<MeshStats>,
     /// The BVH over the scene's objects, when there are enough objects to build one.
     pub scene_bvh: Option<BvhStats>,
+}
+
+/// The faces of a cube map that rays looked at: decoded from their PNGs, or read back from the
+/// texel cache (`goldray::texel_cache`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct CubeMapFaces {
+    pub decoded: u32,
+    pub read_from_cache: u32,
 }
 
 /// Wall-clock time of each phase of a render; `total` also covers what falls between them.

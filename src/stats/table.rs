@@ -44,6 +44,11 @@ impl Display for RenderStats {
             row(f, 6, "scene BVH build", &[duration(bvh.build_time)])?;
         }
         row(f, 4, "render", &[duration(times.render)])?;
+        // Faces are loaded when a ray first looks at them, so during the render.
+        if let Some(faces) = build.cube_map_faces {
+            let loaded = format!("{} decoded, {} cached", faces.decoded, faces.read_from_cache);
+            row(f, 6, "cube map faces", &[loaded])?;
+        }
         row(f, 4, "write outputs", &[duration(times.write)])?;
         row(f, 4, "total", &[duration(times.total)])?;
 

@@ -69,6 +69,7 @@ fn stats_print_a_table_and_write_json_without_changing_the_exr() {
     assert_eq!(count(&json, "total"), sum);
     assert!(count(&json, "shadow") > 0 && count(&json, "reflection") > 0);
     assert!(json["seconds"]["render"].as_f64().unwrap() > 0.0);
+    assert!(json["cube_map_faces"].is_null(), "no cube map, no faces");
     assert!(json["mrays_per_second"]["total"].as_f64().unwrap() > 0.0);
     if cfg!(target_os = "linux") {
         assert!(json["peak_memory_bytes"].as_u64().unwrap() > 1 << 20);
