@@ -114,9 +114,16 @@ impl TexelCache {
         self.prune(&entry)
     }
 
-    /// Where the texels of `png` are kept: a hash of the file's bytes names them.
+    /// Where the texels of `png` are kept: a hash of the file's bytes, and of goldray's version,
+    /// names them. An 8-bit RGB face's texels are its bytes whatever decodes them, but a face of
+    /// another kind is converted (`rgb_image::decode_png`), and another version might convert it
+    /// otherwise: its entries are not shared.
     fn entry(&self, png: &[u8]) -> PathBuf {
-        let hash = blake3::hash(png).to_hex();
+        let mut hasher = blake3::Hasher::new();
+        hasher.update(env!("CARGO_PKG_VERSION").as_bytes());
+        hasher.update(&[0]);
+        hasher.update(png);
+        let hash = hasher.finalize().to_hex();
         self.dir.join(format!("{}.{EXTENSION}", &hash[..32]))
     }
 
