@@ -11,15 +11,17 @@
 //! An entry is used only when it is whole and sound: its header names the face's size, and a
 //! CRC-32 of its texels must match, so a damaged or foreign file is decoded again (and
 //! replaced), never shown. Pictures are therefore the same with the cache, without it, and
-//! with a damaged one. Entries are written to a temporary file and renamed, so that another
-//! process reads an old entry or a whole new one; the folder is kept under a size limit by
-//! removing the entries written longest ago.
+//! with a damaged one. Entries are replaced atomically without a sync
+//! (`atomic_write::replace_file`), so that another process reads an old entry or a whole new
+//! one; the folder is kept under a size limit by removing the entries written longest ago.
 
 use std::fs::{self, File};
-use std::io::{self, Read, Write};
+use std::io::{self, Read};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 use std::time::SystemTime;
+
+use crate::atomic_write::replace_file;
 
 /// The first bytes of every entry; a change of format changes them, and entries of another
 /// format are then decoded again.
@@ -72,11 +74,26 @@ impl TexelCache {
         INSTALLED.get()
     }
 
-    /// The texels of `png`, a face of `width` × `height` texels, if an entry holds them whole.
-    pub fn read(&self, png: &[u8], width: usize, height: usize) -> Option<Vec<u8>> {
+    /// Where the texels decoded from `png` are kept: a hash of the file's bytes, and of
+    /// goldray's version, names them. An 8-bit RGB face's texels are its bytes whatever decodes
+    /// them, but a face of another kind is converted (`rgb_image::decode_png`), and another
+    /// version might convert it otherwise: its entries are not shared. Named once per face, for
+    /// both [`TexelCache::read`] and [`TexelCache::write`] (hashing a course face takes 0.35 ms).
+    pub fn entry(&self, png: &[u8]) -> PathBuf {
+        let mut hasher = blake3::Hasher::new();
+        hasher.update(env!("CARGO_PKG_VERSION").as_bytes());
+        hasher.update(&[0]);
+        hasher.update(png);
+        let hash = hasher.finalize().to_hex();
+        self.dir.join(format!("{}.{EXTENSION}", &hash[..32]))
+    }
+
+    /// The texels of a face of `width` × `height` texels, if `entry` (from [`TexelCache::entry`])
+    /// holds them whole.
+    pub fn read(&self, entry: &Path, width: usize, height: usize) -> Option<Vec<u8>> {
         let length = texel_bytes(width, height)?;
         let entry_bytes = HEADER_BYTES.checked_add(length)?;
-        let mut file = File::open(self.entry(png)).ok()?;
+        let mut file = File::open(entry).ok()?;
         // The size first, so that a foreign file allocates nothing beyond a face's texels.
         if file.metadata().ok()?.len() != entry_bytes as u64 {
             return None;
@@ -92,41 +109,24 @@ impl TexelCache {
         (texels.len() == length && crc32fast::hash(&texels) == word(16)).then_some(texels)
     }
 
-    /// Stores the texels decoded from `png`, then removes the entries written longest ago
-    /// while the folder is over its limit (never the new one).
-    pub fn write(&self, png: &[u8], width: usize, height: usize, texels: &[u8]) -> io::Result<()> {
+    /// Stores a face's texels in `entry` (from [`TexelCache::entry`]), then removes the entries
+    /// written longest ago while the folder is over its limit (never the new one).
+    pub fn write(&self, entry: &Path, width: usize, height: usize, texels: &[u8]) -> io::Result<()> {
         if texel_bytes(width, height) != Some(texels.len()) {
             return Err(io::Error::new(
                 io::ErrorKind::InvalidInput,
                 "the texels do not fill the face",
             ));
         }
-        fs::create_dir_all(&self.dir)?;
-        let mut header = Vec::with_capacity(HEADER_BYTES);
-        header.extend(MAGIC);
+        let mut bytes = Vec::with_capacity(HEADER_BYTES + texels.len());
+        bytes.extend(MAGIC);
         for word in [width as u32, height as u32, crc32fast::hash(texels)] {
-            header.extend(word.to_le_bytes());
+            bytes.extend(word.to_le_bytes());
         }
+        bytes.extend_from_slice(texels);
         // Not synced: an entry lost or cut short by a crash fails its checks and is made again.
-        let mut file = tempfile::Builder::new().prefix(".texels-").tempfile_in(&self.dir)?;
-        file.write_all(&header)?;
-        file.write_all(texels)?;
-        let entry = self.entry(png);
-        file.persist(&entry).map_err(|error| error.error)?;
-        self.prune(&entry)
-    }
-
-    /// Where the texels of `png` are kept: a hash of the file's bytes, and of goldray's version,
-    /// names them. An 8-bit RGB face's texels are its bytes whatever decodes them, but a face of
-    /// another kind is converted (`rgb_image::decode_png`), and another version might convert it
-    /// otherwise: its entries are not shared.
-    fn entry(&self, png: &[u8]) -> PathBuf {
-        let mut hasher = blake3::Hasher::new();
-        hasher.update(env!("CARGO_PKG_VERSION").as_bytes());
-        hasher.update(&[0]);
-        hasher.update(png);
-        let hash = hasher.finalize().to_hex();
-        self.dir.join(format!("{}.{EXTENSION}", &hash[..32]))
+        replace_file(entry, &bytes).map_err(io::Error::other)?;
+        self.prune(entry)
     }
 
     /// Removes the entries written longest ago, but not `kept`, until the folder's entries fit
@@ -190,15 +190,19 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let cache = TexelCache::new(dir.path().join("texels"), DEFAULT_LIMIT_BYTES);
         let face = texels(5, 3, 1);
-        assert_eq!(cache.read(b"png one", 5, 3), None, "nothing stored yet");
-        cache.write(b"png one", 5, 3, &face).unwrap();
-        assert_eq!(cache.read(b"png one", 5, 3), Some(face));
+        assert_eq!(cache.read(&cache.entry(b"png one"), 5, 3), None, "nothing stored yet");
+        cache.write(&cache.entry(b"png one"), 5, 3, &face).unwrap();
+        assert_eq!(cache.read(&cache.entry(b"png one"), 5, 3), Some(face));
         assert_eq!(
-            cache.read(b"png two", 5, 3),
+            cache.read(&cache.entry(b"png two"), 5, 3),
             None,
             "another file's bytes name another entry"
         );
-        assert_eq!(cache.read(b"png one", 3, 5), None, "the size must match the face's");
+        assert_eq!(
+            cache.read(&cache.entry(b"png one"), 3, 5),
+            None,
+            "the size must match the face's"
+        );
         let names = entries(cache.dir());
         assert_eq!(names.len(), 1, "no temporary file is left: {names:?}");
     }
@@ -208,25 +212,25 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let cache = TexelCache::new(dir.path().to_path_buf(), DEFAULT_LIMIT_BYTES);
         let face = texels(4, 4, 9);
-        cache.write(b"face", 4, 4, &face).unwrap();
         let entry = cache.entry(b"face");
+        cache.write(&entry, 4, 4, &face).unwrap();
         let sound = fs::read(&entry).unwrap();
 
         let mut flipped = sound.clone();
         flipped[HEADER_BYTES + 17] ^= 0x10;
         fs::write(&entry, &flipped).unwrap();
-        assert_eq!(cache.read(b"face", 4, 4), None, "a texel changed: the CRC tells");
+        assert_eq!(cache.read(&entry, 4, 4), None, "a texel changed: the CRC tells");
 
         fs::write(&entry, &sound[..sound.len() - 1]).unwrap();
-        assert_eq!(cache.read(b"face", 4, 4), None, "cut short");
+        assert_eq!(cache.read(&entry, 4, 4), None, "cut short");
 
         let mut foreign = sound.clone();
         foreign[7] = b'9';
         fs::write(&entry, &foreign).unwrap();
-        assert_eq!(cache.read(b"face", 4, 4), None, "another format");
+        assert_eq!(cache.read(&entry, 4, 4), None, "another format");
 
-        cache.write(b"face", 4, 4, &face).unwrap();
-        assert_eq!(cache.read(b"face", 4, 4), Some(face), "written again, it is used again");
+        cache.write(&entry, 4, 4, &face).unwrap();
+        assert_eq!(cache.read(&entry, 4, 4), Some(face), "written again, it is used again");
     }
 
     #[test]
@@ -236,21 +240,23 @@ mod tests {
         let cache = TexelCache::new(dir.path().to_path_buf(), 2 * entry_bytes);
         let old = SystemTime::now() - std::time::Duration::from_secs(3600);
         for (k, name) in [&b"a"[..], b"b"].into_iter().enumerate() {
-            cache.write(name, 10, 10, &texels(10, 10, k as u8)).unwrap();
+            cache
+                .write(&cache.entry(name), 10, 10, &texels(10, 10, k as u8))
+                .unwrap();
             let file = File::options().write(true).open(cache.entry(name)).unwrap();
             file.set_modified(old + std::time::Duration::from_secs(k as u64))
                 .unwrap();
         }
         fs::write(dir.path().join("notes.txt"), "not an entry").unwrap();
-        cache.write(b"c", 10, 10, &texels(10, 10, 2)).unwrap();
-        assert_eq!(cache.read(b"a", 10, 10), None, "the oldest entry went");
-        assert!(cache.read(b"b", 10, 10).is_some() && cache.read(b"c", 10, 10).is_some());
+        cache.write(&cache.entry(b"c"), 10, 10, &texels(10, 10, 2)).unwrap();
+        assert_eq!(cache.read(&cache.entry(b"a"), 10, 10), None, "the oldest entry went");
+        assert!(cache.read(&cache.entry(b"b"), 10, 10).is_some() && cache.read(&cache.entry(b"c"), 10, 10).is_some());
         assert!(dir.path().join("notes.txt").exists(), "only entries are removed");
 
         let tiny = TexelCache::new(dir.path().to_path_buf(), 1);
-        tiny.write(b"d", 10, 10, &texels(10, 10, 3)).unwrap();
+        tiny.write(&tiny.entry(b"d"), 10, 10, &texels(10, 10, 3)).unwrap();
         assert!(
-            tiny.read(b"d", 10, 10).is_some(),
+            tiny.read(&tiny.entry(b"d"), 10, 10).is_some(),
             "the entry just written stays, even over the limit"
         );
         assert_eq!(entries(dir.path()).len(), 2, "d and the notes");
@@ -262,10 +268,10 @@ mod tests {
         let file = dir.path().join("a file");
         fs::write(&file, "").unwrap();
         let cache = TexelCache::new(file.join("texels"), DEFAULT_LIMIT_BYTES);
-        assert!(cache.write(b"face", 1, 1, &[1, 2, 3]).is_err());
-        assert_eq!(cache.read(b"face", 1, 1), None);
+        assert!(cache.write(&cache.entry(b"face"), 1, 1, &[1, 2, 3]).is_err());
+        assert_eq!(cache.read(&cache.entry(b"face"), 1, 1), None);
         assert!(
-            cache.write(b"face", 2, 1, &[1, 2, 3]).is_err(),
+            cache.write(&cache.entry(b"face"), 2, 1, &[1, 2, 3]).is_err(),
             "texels that do not fill the face"
         );
     }

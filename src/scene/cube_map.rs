@@ -4,7 +4,6 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
-use std::sync::atomic::{AtomicBool, Ordering};
 
 use rayon::prelude::*;
 
@@ -27,13 +26,19 @@ struct Face {
     png: Vec<u8>,
     width: usize,
     height: usize,
-    /// Red, green and blue bytes texel by texel, row by row, row 0 at the top; or why the data
-    /// could not be decoded.
-    texels: OnceLock<Result<Vec<u8>, String>>,
+    /// The texels, once a ray looked; or why the data could not be decoded.
+    texels: OnceLock<Result<Texels, String>>,
     /// Where decoded texels are kept between runs, if anywhere.
     cache: Option<&'static TexelCache>,
-    /// Whether `texels` were read from the cache rather than decoded (for `--stats`).
-    from_cache: AtomicBool,
+}
+
+/// A face's texels and where they came from.
+#[derive(Debug)]
+struct Texels {
+    /// Red, green and blue bytes texel by texel, row by row, row 0 at the top.
+    bytes: Vec<u8>,
+    /// Read back from the texel cache rather than decoded (for `--stats`).
+    read_from_cache: bool,
 }
 
 #[derive(Debug)]
@@ -157,11 +162,10 @@ impl CubeMap {
     pub fn faces_loaded(&self) -> CubeMapFaces {
         let mut faces = CubeMapFaces::default();
         for face in &self.faces {
-            if let Some(Ok(_)) = face.texels.get() {
-                match face.from_cache.load(Ordering::Relaxed) {
-                    true => faces.read_from_cache += 1,
-                    false => faces.decoded += 1,
-                }
+            match face.texels.get() {
+                Some(Ok(texels)) if texels.read_from_cache => faces.read_from_cache += 1,
+                Some(Ok(_)) => faces.decoded += 1,
+                _ => {}
             }
         }
         faces
@@ -187,7 +191,7 @@ impl Face {
         if width == 0 || height == 0 {
             return Err(error("the image is empty".to_string()));
         }
-        Ok(Face { path, png, width: width as usize, height: height as usize, texels: OnceLock::new(), cache, from_cache: AtomicBool::new(false) })
+        Ok(Face { path, png, width: width as usize, height: height as usize, texels: OnceLock::new(), cache })
     }
 
     /// The decoded texels: decoded (or read from the cache) by the first ray to look, which any
@@ -195,20 +199,20 @@ impl Face {
     /// only means the next run decodes them again.
     fn texels(&self) -> Option<&[u8]> {
         let texels = self.texels.get_or_init(|| {
-            if let Some(texels) = self.cache.and_then(|cache| cache.read(&self.png, self.width, self.height)) {
-                self.from_cache.store(true, Ordering::Relaxed);
-                return Ok(texels);
+            let entry = self.cache.map(|cache| (cache, cache.entry(&self.png)));
+            if let Some(bytes) = entry.as_ref().and_then(|(cache, entry)| cache.read(entry, self.width, self.height)) {
+                return Ok(Texels { bytes, read_from_cache: true });
             }
-            let texels = decode_rgb8(&self.png)?;
-            if texels.len() != self.width * self.height * 3 {
+            let bytes = decode_rgb8(&self.png)?;
+            if bytes.len() != self.width * self.height * 3 {
                 return Err("the image data does not match its header".to_string());
             }
-            if let Some(cache) = self.cache {
-                let _ = cache.write(&self.png, self.width, self.height, &texels);
+            if let Some((cache, entry)) = entry {
+                let _ = cache.write(&entry, self.width, self.height, &bytes);
             }
-            Ok(texels)
+            Ok(Texels { bytes, read_from_cache: false })
         });
-        texels.as_deref().ok()
+        texels.as_ref().ok().map(|texels| texels.bytes.as_slice())
     }
 
     /// The four texels a lookup at `(u, v)` blends, with the reference's edge-clamped indices,
@@ -344,8 +348,8 @@ mod tests {
     use super::*;
 
     fn face(width: usize, height: usize, texels: Vec<[u8; 3]>) -> Face {
-        let texels = OnceLock::from(Ok(texels.into_flattened()));
-        Face { path: PathBuf::new(), png: Vec::new(), width, height, texels, cache: None, from_cache: AtomicBool::new(false) }
+        let texels = OnceLock::from(Ok(Texels { bytes: texels.into_flattened(), read_from_cache: false }));
+        Face { path: PathBuf::new(), png: Vec::new(), width, height, texels, cache: None }
     }
 
     fn uniform_face(byte: u8) -> Face {
@@ -494,13 +498,13 @@ mod tests {
         let map = CubeMap::load_cached(dir.path(), Some(cache)).unwrap();
         assert_eq!(map.radiance(-Vec3::X), decoded);
         let left = std::fs::read(dir.path().join("left.png")).unwrap();
-        assert_eq!(cache.read(&left, 2, 2), Some([200, 100, 50].repeat(4)), "the decoded face was stored");
+        assert_eq!(cache.read(&cache.entry(&left), 2, 2), Some([200, 100, 50].repeat(4)), "the decoded face was stored");
         assert_eq!(map.radiance(Vec3::X), Color::ZERO, "the damaged face still shows black");
         assert_eq!(std::fs::read_dir(cache_dir.path()).unwrap().count(), 1, "nothing stored for it");
 
         // Every face but `right` is the same PNG, so one entry serves them all: give it other
         // texels, and a new map shows those without decoding.
-        cache.write(&left, 2, 2, &[7; 12]).unwrap();
+        cache.write(&cache.entry(&left), 2, 2, &[7; 12]).unwrap();
         let map = CubeMap::load_cached(dir.path(), Some(cache)).unwrap();
         assert_eq!(map.radiance(Vec3::Y), Color::splat(value(7)), "read from the cache");
 
@@ -511,7 +515,7 @@ mod tests {
         std::fs::write(&entry, bytes).unwrap();
         let map = CubeMap::load_cached(dir.path(), Some(cache)).unwrap();
         assert_eq!(map.radiance(Vec3::Z), decoded);
-        assert_eq!(cache.read(&left, 2, 2), Some([200, 100, 50].repeat(4)), "repaired");
+        assert_eq!(cache.read(&cache.entry(&left), 2, 2), Some([200, 100, 50].repeat(4)), "repaired");
     }
 
     #[test]
